@@ -1,0 +1,6 @@
+"""Generalized plants, norms and scaling of continuous-time LTI systems."""
+
+from .checks import as_statespace
+from .plant import GeneralizedPlant, lft
+
+__all__ = ["GeneralizedPlant", "lft", "as_statespace"]

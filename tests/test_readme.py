@@ -1,0 +1,27 @@
+"""The README's Quickstart is what CI runs."""
+
+import re
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def quickstart_lines():
+    text = (ROOT / "README.md").read_text()
+    section = text.split("## Quickstart", 1)[1]
+    block = re.search(r"```(?:bash|sh)?\n(.*?)```", section, re.S).group(1)
+    return [line for line in block.splitlines() if line.strip()]
+
+
+def test_quickstart_has_exactly_two_command_lines():
+    lines = quickstart_lines()
+    assert len(lines) == 2, lines
+    assert lines[0].startswith("pip install") and "lmi-suspension" in lines[0]
+    assert lines[1].startswith("pip install") and "pytest" in lines[1]
+
+
+def test_ci_runs_quickstart_line_two():
+    ci = (ROOT / ".ci" / "run").read_text().splitlines()
+    commands = [c for c in ci if c.strip() and not c.startswith("#")
+                and not c.startswith(("set ", "cd ", "export "))]
+    assert commands == [quickstart_lines()[1]]
