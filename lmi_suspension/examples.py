@@ -1,0 +1,73 @@
+"""Textbook generalized plants used in tests, benchmarks and notebooks.
+
+Each function returns a :class:`ExamplePlant` with the plant, its partition and, for
+µ problems, the block structure.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+__all__ = ["ExamplePlant", "skogestad_distillation"]
+
+
+@dataclass(frozen=True)
+class ExamplePlant:
+    """A generalized plant with its partition and (optionally) its µ block structure."""
+
+    P: control.StateSpace
+    nmeas: int
+    ncon: int
+    blk: np.ndarray | None = None
+    source: str = ""
+
+
+def skogestad_distillation() -> ExamplePlant:
+    """Robust-performance problem of the ill-conditioned distillation column.
+
+    Skogestad & Postlethwaite, *Multivariable Feedback Control*, 2nd ed. (2005),
+    Section 8.12.4 and Table 8.1: ``G(s) = 1/(75 s + 1) [[87.8, -86.4], [108.2, -109.6]]``,
+    input uncertainty ``W_I(s) = (s + 0.2)/(0.5 s + 1) I`` (diagonal, two 1×1 complex
+    blocks) and performance weight ``w_P(s) = (s/2 + 0.05)/s`` approximated by
+    ``0.5 (10 s + 1)/(10 s + 1e-5)``. The µ structure is ``[[1, 1], [1, 1], [2, 2]]``.
+
+    Inputs ``[u_del(2); w(2); u(2)]``, outputs ``[y_del(2); z(2); v(2)]`` with
+    ``y_del = W_I u``, ``z = W_P (G (u + u_del) + w)``, ``v = -(G (u + u_del) + w)``.
+
+    Examples
+    --------
+    >>> ex = skogestad_distillation()
+    >>> ex.P.nstates, ex.P.ninputs, ex.P.noutputs
+    (6, 6, 6)
+    """
+    G = control.ss([[-1 / 75, 0], [0, -1 / 75]], np.eye(2) / 75,
+                   [[87.8, -86.4], [108.2, -109.6]], np.zeros((2, 2)),
+                   inputs=["ug[0]", "ug[1]"], outputs=["g[0]", "g[1]"], name="G")
+    wp = control.ss(0.5 * control.tf([10, 1], [10, 1e-5]))
+    wi = control.ss(control.tf([1, 0.2], [0.5, 1]))
+    Wp = control.append(wp, wp)
+    Wi = control.append(wi, wi)
+    Wp = control.ss(Wp.A, Wp.B, Wp.C, Wp.D, inputs=["e[0]", "e[1]"], outputs=["z[0]", "z[1]"],
+                    name="Wp")
+    Wi = control.ss(Wi.A, Wi.B, Wi.C, Wi.D, inputs=["u[0]", "u[1]"],
+                    outputs=["ydel[0]", "ydel[1]"], name="Wi")
+    in_sum = control.summing_junction(inputs=["u", "udel"], output="ug", dimension=2,
+                                      name="in_sum")
+    out_sum = control.summing_junction(inputs=["g", "w"], output="e", dimension=2,
+                                       name="out_sum")
+    meas = control.ss([], [], [], -np.eye(2), inputs=["e[0]", "e[1]"], outputs=["v[0]", "v[1]"],
+                      name="meas")
+    P = control.interconnect(
+        [G, Wp, Wi, in_sum, out_sum, meas],
+        inplist=["udel[0]", "udel[1]", "w[0]", "w[1]", "u[0]", "u[1]"],
+        outlist=["ydel[0]", "ydel[1]", "z[0]", "z[1]", "v[0]", "v[1]"],
+        name="distillation")
+    P = control.minreal(P, verbose=False)
+    P = control.ss(P.A, P.B, P.C, P.D, name="distillation",
+                   inputs=["udel[0]", "udel[1]", "w[0]", "w[1]", "u[0]", "u[1]"],
+                   outputs=["ydel[0]", "ydel[1]", "z[0]", "z[1]", "v[0]", "v[1]"])
+    return ExamplePlant(P=P, nmeas=2, ncon=2, blk=np.array([[1, 1], [1, 1], [2, 2]]),
+                        source="Skogestad & Postlethwaite (2005), Sec. 8.12.4, Table 8.1")

@@ -1,0 +1,399 @@
+"""The augmented seat plant of Fig. 2 for µ-synthesis: weights, uncertainty channels and
+the block structure ``blk`` (MATLAB's convention).
+
+Signal flow (all names are the plant's input/output labels)::
+
+    w  (normalised)  --> w_scale --> ż0 (m/s) ---------------------------+
+    u  (N) --+--> W_delay --> q_delay                                     |
+             +--(+ p_delay)--> N(s) --> u_act --> [uncertain seat core] <-+
+             +--> W_u --> e_force                       |   z3dd --> W_k/acc_ref --> e_acc
+                                                        |   x1 --> 1/z_max --> e_defl
+    n1, n2 (normalised) --> noise scales --(+)--> y1, y2 (m)
+
+The core is the seat model (eq. 15) with, when selected, the real parametric channels
+(:func:`~lmi_suspension.seat.uncertainty.parametric_uncertainty`) and the paper's
+norm-bounded channels (:func:`~lmi_suspension.seat.uncertainty.paper_norm_bounded`,
+ΔA, ΔB acting on ``[x; u_act]``, ΔC1 on z̈3, ΔC3 on the measurements).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import numbers
+from dataclasses import dataclass
+
+import control
+import numpy as np
+
+from ..errors import NonFiniteError, ParameterError
+from .model import seat_model
+from .params import SeatParameters
+from .uncertainty import (DelayUncertainty, delay_uncertainty, paper_norm_bounded,
+                          parametric_uncertainty)
+from .weights import wk_weight
+
+__all__ = ["SeatDesignOptions", "SeatAugmentedPlant", "seat_augmented_plant",
+           "BUMP_PEAK_VELOCITY"]
+
+logger = logging.getLogger(__name__)
+
+#: Peak floor velocity of the bump of eq. (32), ``a π V0 / l`` with a = 0.1 m,
+#: V0 = 30 km/h, l = 2 m: about 1.31 m/s.
+BUMP_PEAK_VELOCITY = 0.1 * math.pi * (30.0 / 3.6) / 2.0
+
+
+@dataclass(frozen=True)
+class SeatDesignOptions:
+    """Every weight and uncertainty choice of the seat µ design in one place.
+
+    Attributes
+    ----------
+    acc_ref : float
+        Wk-weighted z̈3 (m/s²) that counts as a unit error (performance gain 1/acc_ref).
+        With the default 10 m/s² the passive seat's peak weighted gain from the
+        normalised ``w`` is about 4.2 (42 m/s² at 2.2 Hz): a tuning knob, not a result.
+    wk_order : {2, 3, 4}
+        Order of the ISO 2631-1 Wk approximation (:func:`~.weights.wk_weight`).
+    u_max : float or None
+        Force scale of eq. (12), N; ``None`` takes ``params.u_max``.
+    force_rolloff_ratio : float
+        High-frequency increase of the force weight (1 = static ``1/u_max``); otherwise
+        ``(1/u_max)(1 + s/ω_f)/(1 + s/(ratio ω_f))``.
+    force_rolloff_corner : float
+        ``ω_f`` in rad/s.
+    z_max : float or None
+        Deflection scale of eq. (13), m; ``None`` takes ``params.z_max``.
+    w_scale : float
+        Floor-velocity scale, m/s (default: the bump's peak ż0, :data:`BUMP_PEAK_VELOCITY`).
+    noise : tuple of float
+        Sensor-noise scales on ``y = [x1, x3]``, m.
+    include_delay, include_parametric, include_paper : bool
+        Which uncertainty channels the plant carries.
+    delay_min, delay_max : float or None
+        Delay interval, s; ``None`` takes ``params.delay_min`` / ``params.delay_max``.
+    delay_nominal : {"pade", "none"}
+    delay_order : int
+        Order of the delay weight (1–3).
+    delay_margin : float
+        Relative safety margin of the delay cover.
+    m3_range : (float, float) or None
+        Occupant mass range, kg (``None``: m3 fixed).
+    stiffness, stiffness_rel, damping, damping_rel
+        Uncertain springs/dampers and their relative ranges.
+    parametric_complex : bool
+        Give the parametric scalars complex ``[1, 1]`` rows in ``blk`` (a cover of the
+        real ones) instead of real ``[-1, 0]`` rows.
+    paper_delta : float
+        δ of the paper's norm-bounded uncertainty (0.02).
+
+    Examples
+    --------
+    >>> from lmi_suspension.seat import augmented
+    >>> opts = augmented.SeatDesignOptions(include_paper=False, noise=(1e-4, 1e-4))
+    >>> opts.include_delay, opts.noise
+    (True, (0.0001, 0.0001))
+    """
+
+    acc_ref: float = 10.0
+    wk_order: int = 4
+    u_max: float | None = None
+    force_rolloff_ratio: float = 1.0
+    force_rolloff_corner: float = 2 * math.pi * 30.0
+    z_max: float | None = None
+    w_scale: float = BUMP_PEAK_VELOCITY
+    noise: tuple[float, float] = (5e-4, 5e-4)
+    include_delay: bool = True
+    include_parametric: bool = True
+    include_paper: bool = True
+    delay_min: float | None = None
+    delay_max: float | None = None
+    delay_nominal: str = "pade"
+    delay_order: int = 2
+    delay_margin: float = 0.02
+    m3_range: tuple[float, float] | None = (30.0, 70.0)
+    stiffness: tuple[str, ...] = ("k1",)
+    stiffness_rel: float = 0.2
+    damping: tuple[str, ...] = ()
+    damping_rel: float = 0.2
+    parametric_complex: bool = False
+    paper_delta: float = 0.02
+
+    def __post_init__(self):
+        def num(name, value, *, positive=True, allow_none=False):
+            if value is None and allow_none:
+                return
+            if isinstance(value, bool) or not isinstance(value, numbers.Real):
+                raise ParameterError(f"{name} must be a real number, got {value!r}")
+            if not math.isfinite(value):
+                raise NonFiniteError(f"{name} must be finite, got {value!r}")
+            if positive and value <= 0:
+                raise ParameterError(f"{name} must be positive, got {value!r}")
+            if not positive and value < 0:
+                raise ParameterError(f"{name} must be >= 0, got {value!r}")
+
+        for name in ("acc_ref", "force_rolloff_corner", "w_scale"):
+            num(name, getattr(self, name))
+        for name in ("u_max", "z_max"):
+            num(name, getattr(self, name), allow_none=True)
+        for name in ("delay_min", "delay_max"):
+            num(name, getattr(self, name), positive=False, allow_none=True)
+        num("paper_delta", self.paper_delta, positive=False)
+        num("force_rolloff_ratio", self.force_rolloff_ratio)
+        if self.force_rolloff_ratio < 1:
+            raise ParameterError("force_rolloff_ratio must be >= 1 (a high-frequency increase)")
+        if self.delay_min is not None and self.delay_max is not None \
+                and self.delay_max < self.delay_min:
+            raise ParameterError(
+                f"delay_max ({self.delay_max}) must not be below delay_min ({self.delay_min})")
+        noise = tuple(self.noise)
+        if len(noise) != 2:
+            raise ParameterError(f"noise needs two scales (y1, y2), got {self.noise!r}")
+        for i, v in enumerate(noise):
+            num(f"noise[{i}]", v)
+        object.__setattr__(self, "noise", tuple(float(v) for v in noise))
+        for name in ("include_delay", "include_parametric", "include_paper",
+                     "parametric_complex"):
+            if not isinstance(getattr(self, name), bool):
+                raise ParameterError(f"{name} must be True or False")
+        if self.wk_order not in (2, 3, 4) or isinstance(self.wk_order, bool):
+            raise ParameterError(f"wk_order must be 2, 3 or 4, got {self.wk_order!r}")
+        if self.delay_nominal not in ("pade", "none"):
+            raise ParameterError(f"delay_nominal must be 'pade' or 'none'")
+        if self.delay_order not in (1, 2, 3) or isinstance(self.delay_order, bool):
+            raise ParameterError(f"delay_order must be 1, 2 or 3, got {self.delay_order!r}")
+        num("delay_margin", self.delay_margin)
+        if self.m3_range is not None:
+            lo, hi = self.m3_range
+            num("m3_range[0]", lo)
+            num("m3_range[1]", hi)
+            if hi <= lo:
+                raise ParameterError(f"m3_range must be increasing, got {self.m3_range}")
+        num("stiffness_rel", self.stiffness_rel)
+        num("damping_rel", self.damping_rel)
+        object.__setattr__(self, "stiffness", tuple(self.stiffness))
+        object.__setattr__(self, "damping", tuple(self.damping))
+
+
+@dataclass(frozen=True)
+class SeatAugmentedPlant:
+    """The generalized plant of Fig. 2 with its block structure.
+
+    Attributes
+    ----------
+    P : control.StateSpace
+        Inputs ``[p_<block>..., 'w', 'n1', 'n2', 'u']``, outputs ``[q_<block>...,
+        'e_acc', 'e_force', 'e_defl', 'y1', 'y2']``.
+    nmeas, ncon : int
+        2 measurements (last outputs) and 1 control (last input).
+    blk : ndarray of int, shape (nblocks, 2)
+        MATLAB ``mussv`` rows ``[r, c]``: block i is r_i × c_i, maps the plant's c_i
+        uncertainty outputs to its r_i uncertainty inputs; ``[-1, 0]`` is a real scalar.
+        The last row is the performance block ``[3, 3]`` (errors → disturbances).
+        ``M = F_l(P, K)`` is ``(Σ c_i) × (Σ r_i)``.
+    block_names : tuple of str
+        One name per row of ``blk`` (``'delay'``, ``'m3'``, ``'k1'``, ..., ``'nb_AB'``,
+        ``'nb_C1'``, ``'nb_C3'``, ``'performance'``).
+    options : SeatDesignOptions
+    params : SeatParameters
+        Parameters of the nominal model (m3 moved to the range centre when the
+        parametric uncertainty is on).
+    delay : DelayUncertainty or None
+        The delay cover used; ``None`` when ``include_delay`` is False (ideal actuator).
+    """
+
+    P: control.StateSpace
+    nmeas: int
+    ncon: int
+    blk: np.ndarray
+    block_names: tuple[str, ...]
+    options: SeatDesignOptions
+    params: SeatParameters
+    delay: DelayUncertainty | None
+
+    @property
+    def n_unc_inputs(self) -> int:
+        """Number of uncertainty inputs ``p`` (first inputs of ``P``)."""
+        return int(sum(1 if r == -1 else r for r, _ in self.blk[:-1]))
+
+    @property
+    def n_unc_outputs(self) -> int:
+        """Number of uncertainty outputs ``q`` (first outputs of ``P``)."""
+        return int(sum(1 if r == -1 else c for r, c in self.blk[:-1]))
+
+    def __iter__(self):
+        # Unpack like python-control's (P, nmeas, ncon) triple plus the structure.
+        return iter((self.P, self.nmeas, self.ncon, self.blk))
+
+
+def _static(gain, inp, out, name):
+    return control.ss([], [], [], np.atleast_2d(gain), inputs=inp, outputs=out, name=name)
+
+
+def _core(params: SeatParameters, opts: SeatDesignOptions):
+    """Uncertain seat core: inputs [p..., 'zdot0', 'u_act'], outputs [q..., 'z3dd', 'x1',
+    'y1m', 'y2m'], plus the (names, blk rows) of its blocks."""
+    names: list[str] = []
+    rows: list[list[int]] = []
+    if opts.include_parametric:
+        pu = parametric_uncertainty(params, opts.m3_range, opts.stiffness_rel,
+                                    stiffness=opts.stiffness, damping=opts.damping,
+                                    damping_rel=opts.damping_rel)
+        G = pu.G
+        nominal = pu.nominal
+        npar = len(pu.names)
+        names += list(pu.names)
+        rows += [[1, 1] if opts.parametric_complex else [-1, 0]] * npar
+        A = np.array(G.A)
+        Bp, Bw, Bu = (np.array(G.B[:, :npar]), np.array(G.B[:, npar:npar + 1]),
+                      np.array(G.B[:, npar + 1:]))
+        C = np.array(G.C)
+        D = np.array(G.D)
+        Cq, Cz = C[:npar], C[npar:]
+        Dqp, Dqw, Dqu = D[:npar, :npar], D[:npar, npar:npar + 1], D[:npar, npar + 1:]
+        Dzp, Dzw, Dzu = D[npar:, :npar], D[npar:, npar:npar + 1], D[npar:, npar + 1:]
+        p_labels = [f"p_{n}" for n in pu.names]
+        q_labels = [f"q_{n}" for n in pu.names]
+    else:
+        nominal = params
+        G = seat_model(params)
+        A, Bw, Bu = np.array(G.A), np.array(G.B[:, :1]), np.array(G.B[:, 1:])
+        Cz, Dzw, Dzu = np.array(G.C), np.array(G.D[:, :1]), np.array(G.D[:, 1:])
+        npar = 0
+        Bp, Cq = np.zeros((6, 0)), np.zeros((0, 6))
+        Dqp, Dqw, Dqu = np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((0, 1))
+        Dzp = np.zeros((Cz.shape[0], 0))
+        p_labels, q_labels = [], []
+    # Seat outputs are ['z3dd', 'x1', 'x3', 'y1', 'y2']; keep z3dd, x1, y1, y2.
+    keep = [0, 1, 3, 4]
+    Cz, Dzp, Dzw, Dzu = Cz[keep], Dzp[keep], Dzw[keep], Dzu[keep]
+
+    # Paper norm-bounded channels (independent blocks for A/B, C1 and C3).
+    extra_B, extra_C, extra_Dzp, extra_Dqu = [], [], [], []
+    nb_p, nb_q = [], []
+    if opts.include_paper:
+        nb = paper_norm_bounded(nominal, opts.paper_delta)
+        for key, (left, right) in nb.blocks().items():
+            r, c = left.shape[1], right.shape[0]
+            names.append(key)
+            rows.append([r, c])
+            nb_p += [f"p_{key}[{i}]" for i in range(r)]
+            nb_q += [f"q_{key}[{i}]" for i in range(c)]
+            if key == "nb_AB":
+                extra_B.append(left)  # enters the state equation
+                extra_Dzp.append(np.zeros((4, r)))
+                extra_C.append(right[:, :6])
+                extra_Dqu.append(right[:, 6:])
+            else:
+                extra_B.append(np.zeros((6, r)))
+                Dz = np.zeros((4, r))
+                if key == "nb_C1":
+                    Dz[0:1, :] = left  # z3dd row
+                else:
+                    Dz[2:4, :] = left  # y1m, y2m rows
+                extra_Dzp.append(Dz)
+                extra_C.append(right)
+                extra_Dqu.append(np.zeros((c, 1)))
+    n_nb_p, n_nb_q = len(nb_p), len(nb_q)
+    Bnb = np.hstack(extra_B) if extra_B else np.zeros((6, 0))
+    Cnb = np.vstack(extra_C) if extra_C else np.zeros((0, 6))
+    Dnb_u = np.vstack(extra_Dqu) if extra_Dqu else np.zeros((0, 1))
+    Dz_nb = np.hstack(extra_Dzp) if extra_Dzp else np.zeros((4, 0))
+
+    # Assemble [p_par, p_nb, zdot0, u_act] -> [q_par, q_nb, z3dd, x1, y1m, y2m].
+    B = np.hstack([Bp, Bnb, Bw, Bu])
+    Cfull = np.vstack([Cq, Cnb, Cz])
+    D = np.block([
+        [Dqp, np.zeros((npar, n_nb_p)), Dqw, Dqu],
+        [np.zeros((n_nb_q, npar + n_nb_p)), np.zeros((n_nb_q, 1)), Dnb_u],
+        [Dzp, Dz_nb, Dzw, Dzu],
+    ])
+    core = control.ss(A, B, Cfull, D,
+                      inputs=p_labels + nb_p + ["zdot0", "u_act"],
+                      outputs=q_labels + nb_q + ["z3dd", "x1", "y1m", "y2m"],
+                      states=[f"x{i + 1}" for i in range(6)], name="core")
+    return core, nominal, names, rows, p_labels, q_labels, nb_p, nb_q
+
+
+def seat_augmented_plant(options: SeatDesignOptions | None = None,
+                         params: SeatParameters | None = None) -> SeatAugmentedPlant:
+    """Build the augmented seat plant of Fig. 2 for ``musyn``/``mussv``.
+
+    Parameters
+    ----------
+    options : SeatDesignOptions, optional
+        Weights and uncertainty choices (defaults: all three uncertainties on).
+    params : SeatParameters, optional
+        Physical parameters (Table 1 by default).
+
+    Returns
+    -------
+    SeatAugmentedPlant
+        Unpacks as ``P, nmeas, ncon, blk``.
+
+    Examples
+    --------
+    >>> from lmi_suspension.seat.augmented import seat_augmented_plant, SeatDesignOptions
+    >>> aug = seat_augmented_plant(SeatDesignOptions(include_paper=False))
+    >>> aug.block_names
+    ('delay', 'm3', 'k1', 'performance')
+    >>> aug.blk.tolist()
+    [[1, 1], [-1, 0], [-1, 0], [3, 3]]
+    >>> aug.P.input_labels[-4:], aug.P.output_labels[-5:]
+    (['w', 'n1', 'n2', 'u'], ['e_acc', 'e_force', 'e_defl', 'y1', 'y2'])
+    """
+    opts = SeatDesignOptions() if options is None else options
+    if not isinstance(opts, SeatDesignOptions):
+        raise TypeError(f"options must be a SeatDesignOptions, got {type(opts).__name__}")
+    params = SeatParameters() if params is None else params
+    if not isinstance(params, SeatParameters):
+        raise TypeError(f"params must be a SeatParameters, got {type(params).__name__}")
+    u_max = params.u_max if opts.u_max is None else opts.u_max
+    z_max = params.z_max if opts.z_max is None else opts.z_max
+
+    core, nominal, names, rows, p_par, q_par, p_nb, q_nb = _core(params, opts)
+
+    systems = [core,
+               _static(opts.w_scale, ["w"], ["zdot0"], "w_scale"),
+               control.ss(wk_weight(opts.wk_order, acc_ref=opts.acc_ref),
+                          inputs=["z3dd"], outputs=["e_acc"], name="W_acc"),
+               _static(1.0 / z_max, ["x1"], ["e_defl"], "W_defl"),
+               _static(np.diag(opts.noise), ["n1", "n2"], ["nz1", "nz2"], "W_noise"),
+               control.summing_junction(["y1m", "nz1"], "y1", name="sum_y1"),
+               control.summing_junction(["y2m", "nz2"], "y2", name="sum_y2")]
+    if opts.force_rolloff_ratio == 1.0:
+        systems.append(_static(1.0 / u_max, ["u"], ["e_force"], "W_force"))
+    else:
+        wf, ratio = opts.force_rolloff_corner, opts.force_rolloff_ratio
+        Wf = control.tf([1 / wf, 1], [1 / (ratio * wf), 1]) * (1.0 / u_max)
+        systems.append(control.ss(Wf, inputs=["u"], outputs=["e_force"], name="W_force"))
+
+    p_delay, q_delay, delay = [], [], None
+    d_min = params.delay_min if opts.delay_min is None else opts.delay_min
+    d_max = params.delay_max if opts.delay_max is None else opts.delay_max
+    if opts.include_delay:
+        if d_max < d_min:
+            raise ParameterError(f"delay_max ({d_max}) must not be below delay_min ({d_min})")
+        delay = delay_uncertainty(d_min, d_max, nominal=opts.delay_nominal,
+                                  order=opts.delay_order, margin=opts.delay_margin)
+        # e^{-sd} u = N (u + p_delay), p_delay = δ W u
+        systems += [control.summing_junction(["u", "p_delay"], "u_sum", name="sum_u"),
+                    control.ss(delay.N, inputs=["u_sum"], outputs=["u_act"], name="N_delay"),
+                    control.ss(delay.W, inputs=["u"], outputs=["q_delay"], name="W_delay")]
+        names = ["delay"] + names
+        rows = [[1, 1]] + rows
+        p_delay, q_delay = ["p_delay"], ["q_delay"]
+    else:
+        systems.append(_static(1.0, ["u"], ["u_act"], "ideal_actuator"))
+
+    names.append("performance")
+    rows.append([3, 3])
+    inplist = p_delay + p_par + p_nb + ["w", "n1", "n2", "u"]
+    outlist = q_delay + q_par + q_nb + ["e_acc", "e_force", "e_defl", "y1", "y2"]
+    P = control.interconnect(systems, inplist=inplist, outlist=outlist,
+                             inputs=inplist, outputs=outlist, name="P_seat")
+    P = control.ss(P.A, P.B, P.C, P.D, inputs=inplist, outputs=outlist, name="P_seat")
+    logger.debug("augmented seat plant: %d states, blocks %s", P.nstates, names)
+    return SeatAugmentedPlant(P=P, nmeas=2, ncon=1, blk=np.array(rows, dtype=int),
+                              block_names=tuple(names), options=opts, params=nominal,
+                              delay=delay)
