@@ -7,7 +7,6 @@ mass, damping and stiffness matrices in absolute coordinates and compared as tra
 functions, so an error in either derivation shows up.
 """
 
-import control
 import numpy as np
 import pytest
 

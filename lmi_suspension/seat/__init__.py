@@ -1,6 +1,7 @@
 """The paper's application: seat suspension with a seated-human body model.
 
-model (Table 1, eq. 1) -> uncertainty and weights -> augmented plant of Fig. 2.
+model (Table 1, eq. 1) -> uncertainty and weights -> augmented plant of Fig. 2;
+roads -> exact-delay simulation -> comfort metrics; the physical limit of the bump.
 """
 
 from .augmented import BUMP_PEAK_VELOCITY, SeatAugmentedPlant, SeatDesignOptions, seat_augmented_plant
@@ -9,6 +10,11 @@ from .params import SeatParameters
 from .uncertainty import (DelayUncertainty, NormBounded, ParametricUncertainty, delay_uncertainty,
                           paper_norm_bounded, parametric_uncertainty)
 from .weights import iso2631_wk, makeweight, wk_weight
+from .roads import RoadInput, bump, iso8608_psd, iso8608_road, white_noise
+from .comfort import ComfortMetrics, comfort_metrics, vdv, weighted_rms, wk_filter
+from .simulate import (MonteCarloResult, SimulationMetrics, SimulationResult, closed_loop_stable,
+                       loop_transfer, monte_carlo, simulate, simulate_force, stability_delay_margin)
+from .limit import LimitResult, bump_limit
 
 __all__ = [
     "SeatParameters", "SeatMatrices", "seat_matrices", "seat_model", "natural_modes",
@@ -16,4 +22,9 @@ __all__ = [
     "DelayUncertainty", "delay_uncertainty", "NormBounded", "paper_norm_bounded",
     "ParametricUncertainty", "parametric_uncertainty",
     "SeatDesignOptions", "SeatAugmentedPlant", "seat_augmented_plant", "BUMP_PEAK_VELOCITY",
+    "RoadInput", "bump", "white_noise", "iso8608_road", "iso8608_psd",
+    "ComfortMetrics", "comfort_metrics", "vdv", "weighted_rms", "wk_filter",
+    "SimulationResult", "SimulationMetrics", "MonteCarloResult", "simulate", "simulate_force",
+    "closed_loop_stable", "loop_transfer", "stability_delay_margin", "monte_carlo",
+    "LimitResult", "bump_limit",
 ]

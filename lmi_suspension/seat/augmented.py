@@ -159,7 +159,7 @@ class SeatDesignOptions:
         if self.wk_order not in (2, 3, 4) or isinstance(self.wk_order, bool):
             raise ParameterError(f"wk_order must be 2, 3 or 4, got {self.wk_order!r}")
         if self.delay_nominal not in ("pade", "none"):
-            raise ParameterError(f"delay_nominal must be 'pade' or 'none'")
+            raise ParameterError("delay_nominal must be 'pade' or 'none'")
         if self.delay_order not in (1, 2, 3) or isinstance(self.delay_order, bool):
             raise ParameterError(f"delay_order must be 1, 2 or 3, got {self.delay_order!r}")
         num("delay_margin", self.delay_margin)

@@ -15,7 +15,6 @@ f6 = 3.35 Hz, Q6 = 0.91), gain K = 1.
 from __future__ import annotations
 
 import logging
-import math
 import numbers
 
 import control
@@ -24,14 +23,15 @@ from scipy import optimize, signal
 
 from ..errors import ParameterError
 from ..lti.checks import as_finite_array
+from .comfort import WK_PARAMETERS, wk_filter
 
 __all__ = ["makeweight", "iso2631_wk", "wk_weight", "WK_PARAMETERS"]
 
 logger = logging.getLogger(__name__)
 
 #: ISO 2631-1:1997 Annex A, Table A.2, row Wk (frequencies in Hz).
-WK_PARAMETERS = dict(f1=0.4, f2=100.0, f3=12.5, f4=12.5, Q4=0.63, f5=2.37, Q5=0.91,
-                     f6=3.35, Q6=0.91, K=1.0)
+# ISO 2631-1 Wk lives in comfort.py (one definition for metrics and design weights).
+
 
 
 def _real_scalar(value, name: str) -> float:
@@ -132,21 +132,11 @@ def iso2631_wk() -> control.StateSpace:
     >>> round(abs(complex(Wk(2j * np.pi * 6.3))), 2)   # ISO 2631-1 Table 3: 1.054
     1.05
     """
-    p = WK_PARAMETERS
-    w1, w2 = 2 * math.pi * p["f1"], 2 * math.pi * p["f2"]
-    q1 = 1 / math.sqrt(2)
-    hp = control.tf([1, 0, 0], [1, w1 / q1, w1 ** 2])
-    lp = control.tf([w2 ** 2], [1, w2 / q1, w2 ** 2])
-    return control.ss(hp * lp * _wk_transition_step())
+    return control.ss(wk_filter())
 
 
 def _wk_transition_step() -> control.TransferFunction:
-    p = WK_PARAMETERS
-    w3, w4, w5, w6 = (2 * math.pi * p[k] for k in ("f3", "f4", "f5", "f6"))
-    ht = control.tf([1 / w3, 1], [1 / w4 ** 2, 1 / (p["Q4"] * w4), 1])
-    # DC gain (f5/f6)^2 ~ 0.5 and unit HF gain, as tabulated in ISO 2631-1 Table 3.
-    hs = control.tf([1, w5 / p["Q5"], w5 ** 2], [1, w6 / p["Q6"], w6 ** 2])
-    return p["K"] * ht * hs
+    return wk_filter(band_limited=False)
 
 
 def _fit_low_order(order: int) -> control.TransferFunction:
