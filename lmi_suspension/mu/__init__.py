@@ -1,0 +1,31 @@
+"""Structured singular value µ and µ-synthesis.
+
+block structures -> bounds (``mussv``) -> rational D-scale fits -> D-K iteration (``musyn``).
+"""
+
+from .blocks import Block, BlockKind, BlockStructure
+from .bounds import MussvOptions, MussvResult, MussvTimings, mussv
+from .dfit import DScaleFit, fit_dscales, fit_magnitude, scaled_plant
+from .dk import MusynIteration, MusynOptions, MusynResult, default_omega, musyn
+from .plot import plot_dscales, plot_mu
+
+__all__ = [
+    "Block",
+    "BlockKind",
+    "BlockStructure",
+    "MussvOptions",
+    "MussvResult",
+    "MussvTimings",
+    "mussv",
+    "plot_dscales",
+    "DScaleFit",
+    "fit_dscales",
+    "fit_magnitude",
+    "scaled_plant",
+    "MusynOptions",
+    "MusynIteration",
+    "MusynResult",
+    "musyn",
+    "default_omega",
+    "plot_mu",
+]

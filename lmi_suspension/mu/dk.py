@@ -1,0 +1,414 @@
+"""µ-synthesis by D-K iteration (paper eqs. 23–31).
+
+The loop alternates three exchangeable steps and keeps the diagnostics of each:
+
+1. **K-step** — H∞ synthesis on the D-scaled plant ``P_D`` (:func:`hinfsyn`, LMI by default);
+2. **D-step** — the µ upper bound of ``F_l(P, K)`` over a frequency grid and its optimal
+   D-scales (:func:`mussv`);
+3. **D-fit** — stable, minimum-phase rational fits of those D-scales and the next ``P_D``
+   (:func:`fit_dscales`, :func:`scaled_plant`).
+
+The best iterate (lowest µ peak) is returned, never a worse last one. Repeated real scalar
+blocks are treated as complex in the D-K loop (a conservative but standard simplification);
+the returned µ bounds use the true mixed structure.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import control
+import numpy as np
+
+from ..errors import DimensionError, InfeasibleError, LmiSuspensionError, ParameterError
+from ..lti.checks import as_finite_array
+from ..lti.plant import GeneralizedPlant, lft
+from .blocks import BlockStructure
+
+logger = logging.getLogger(__name__)
+
+__all__ = ["MusynOptions", "MusynIteration", "MusynResult", "musyn", "default_omega"]
+
+
+@dataclass(frozen=True)
+class MusynOptions:
+    """Options of :func:`musyn` (frozen; derive variants with :func:`dataclasses.replace`).
+
+    Attributes
+    ----------
+    max_iter : int
+        Largest number of D-K iterations (each = one K-step, one D-step, one D-fit).
+    mu_target : float
+        Stop as soon as the µ peak falls below this value (``0`` never stops early).
+    patience : int
+        Stop after this many iterations without a relative improvement of at least
+        ``min_improvement`` over the best peak so far.
+    min_improvement : float
+        Relative improvement that counts as progress.
+    method : {"lmi", "riccati"}
+        K-step method of :func:`hinfsyn`.
+    hinfsyn_options : HinfsynOptions or None
+        Options passed to every K-step.
+    max_dfit_order : int
+        Largest order of each D-scale fit.
+    dfit_rtol : float
+        Automatic D-fit order selection: the lowest order whose rational scalings keep the
+        scaled peak ``max_ω σ̄(D̂ M D̂⁻¹)`` within this relative tolerance of the µ peak.
+    n_dense : int
+        Number of frequencies of the dense grid on which the returned controller's µ is
+        re-computed (the reported ``mu_peak``).
+    reduce_order : int or None
+        If set, try a balanced truncation of the best controller to this order and keep it
+        when its µ peak stays within ``reduce_mu_tol`` (relative) of the full-order one.
+    reduce_mu_tol : float
+        Relative µ increase tolerated by the order reduction.
+    """
+
+    max_iter: int = 8
+    mu_target: float = 0.0
+    patience: int = 2
+    min_improvement: float = 5e-3
+    method: str = "lmi"
+    hinfsyn_options: object | None = None
+    max_dfit_order: int = 4
+    dfit_rtol: float = 0.03
+    n_dense: int = 400
+    reduce_order: int | None = None
+    reduce_mu_tol: float = 0.02
+
+    def __post_init__(self):
+        if int(self.max_iter) < 1 or int(self.patience) < 1:
+            raise ParameterError("max_iter and patience must be >= 1")
+        if self.method not in ("lmi", "riccati"):
+            raise ParameterError(f"method must be 'lmi' or 'riccati', got {self.method!r}")
+        if not (self.mu_target >= 0 and self.min_improvement >= 0 and self.dfit_rtol > 0):
+            raise ParameterError("mu_target, min_improvement must be >= 0 and dfit_rtol > 0")
+        if int(self.max_dfit_order) < 0 or int(self.n_dense) < 10:
+            raise ParameterError("max_dfit_order must be >= 0 and n_dense >= 10")
+        if self.reduce_order is not None and int(self.reduce_order) < 0:
+            raise ParameterError("reduce_order must be >= 0")
+
+
+@dataclass(frozen=True)
+class MusynIteration:
+    """Diagnostics of one D-K iteration.
+
+    Attributes
+    ----------
+    index : int
+        1-based iteration number.
+    gamma : float
+        Certified H∞ norm of the D-scaled closed loop (an upper bound of µ at every
+        frequency, not just on the grid, for the fitted D-scales).
+    mu_peak, mu_lower_peak : float
+        Peak of the µ upper and lower bounds on the design grid.
+    peak_omega : float
+        Frequency of the upper-bound peak (rad/s).
+    dfit_orders : tuple of int
+        Order of the D-scale fit of each block used in the *next* K-step (empty on the
+        last iteration if no fit was made).
+    controller_order : int
+        Number of controller states.
+    seconds_k, seconds_d, seconds_fit : float
+        Wall time of the K-step, the D-step and the D-fit.
+    warnings : tuple of str
+        Warnings of the K-step (recoveries, certificate disagreements).
+    """
+
+    index: int
+    gamma: float
+    mu_peak: float
+    mu_lower_peak: float
+    peak_omega: float
+    dfit_orders: tuple
+    controller_order: int
+    seconds_k: float
+    seconds_d: float
+    seconds_fit: float
+    warnings: tuple = ()
+
+
+@dataclass(frozen=True)
+class MusynResult:
+    """Result of :func:`musyn`; unpacks as ``K, CL, mu_peak, info = musyn(...)``.
+
+    Attributes
+    ----------
+    K : control.StateSpace
+        The best controller found (lowest µ peak).
+    CL : control.StateSpace
+        ``F_l(P, K)``.
+    mu_peak, mu_lower_peak : float
+        Peaks of the µ upper and lower bounds of ``CL`` over the dense grid, with the
+        true (mixed) block structure.
+    peak_omega : float
+        Frequency of the upper-bound peak, rad/s.
+    mu : MussvResult
+        The bounds over the dense grid.
+    history : tuple of MusynIteration
+        One record per iteration.
+    best_iteration : int
+        Index of the iteration whose controller is returned.
+    stop_reason : str
+        Why the loop stopped.
+    reduced_from : int or None
+        Order before a successful order reduction, else ``None``.
+    seconds : float
+        Total wall time.
+    """
+
+    K: control.StateSpace
+    CL: control.StateSpace
+    mu_peak: float
+    mu_lower_peak: float
+    peak_omega: float
+    mu: object
+    history: tuple
+    best_iteration: int
+    stop_reason: str
+    reduced_from: int | None = None
+    seconds: float = 0.0
+    omega: np.ndarray = field(default_factory=lambda: np.zeros(0))
+
+    def __iter__(self):
+        return iter((self.K, self.CL, self.mu_peak, self))
+
+
+def default_omega(P, n: int = 60) -> np.ndarray:
+    """A log-spaced grid two decades around the plant's poles (rad/s).
+
+    Examples
+    --------
+    >>> import control
+    >>> w = default_omega(control.ss([[-10.0]], [[1.0]], [[1.0]], [[0.0]]), n=5)
+    >>> float(w[0]), float(w[-1])
+    (0.1, 1000.0)
+    """
+    G = P.sys if isinstance(P, GeneralizedPlant) else P
+    mags = np.abs(np.asarray(G.poles()))
+    mags = mags[mags > 1e-8]
+    lo, hi = (mags.min(), mags.max()) if mags.size else (1.0, 1.0)
+    return np.logspace(np.log10(lo) - 2, np.log10(hi) + 2, int(n))
+
+
+def _complexified(struct: BlockStructure) -> BlockStructure:
+    """Real repeated scalars treated as complex ones (D-K with D scalings only).
+
+    A 1×1 scalar block is written as the full block ``[1, 1]`` (the same set), so that
+    structures of scalars and full blocks stay on mussv's fast path.
+    """
+    rows = []
+    for r, c in struct.to_blk():
+        r, c = abs(int(r)), int(c)
+        rows.append([1, 1] if (r, c) == (1, 0) else [r, c])
+    return BlockStructure.from_blk(rows)
+
+
+def _block_sizes(struct: BlockStructure) -> list[tuple[int, int]]:
+    return [(b.rows, b.cols) for b in struct.blocks]
+
+
+def _freqresp(sys: control.StateSpace, omega: np.ndarray) -> np.ndarray:
+    """Frequency response (n_out × n_in × n_freq) by a Hessenberg-free direct solve."""
+    A, B, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.B, sys.C, sys.D))
+    n = A.shape[0]
+    out = np.empty((C.shape[0], B.shape[1], omega.size), dtype=complex)
+    I = np.eye(n)
+    for k, w in enumerate(omega):
+        out[:, :, k] = D + (C @ np.linalg.solve(1j * w * I - A, B) if n else 0.0)
+    return out
+
+
+def _mu_bounds(CL, struct, omega, rng):
+    from .bounds import mussv
+
+    return mussv(_freqresp(CL, omega), struct, omega=omega, rng=rng)
+
+
+def _scaled_peak(fits, M: np.ndarray, omega: np.ndarray, struct: BlockStructure) -> float:
+    """``max_ω σ̄(D̂_L(jω) M(jω) D̂_R(jω)⁻¹)`` for rational D-scale fits: the bound the next
+    K-step will actually see, so the D-fit order is chosen by it."""
+    s = 1j * omega
+    left = np.empty((M.shape[0], omega.size), dtype=complex)
+    right = np.empty((M.shape[1], omega.size), dtype=complex)
+    row = col = 0
+    for block, fit in zip(struct.blocks, fits):
+        resp = np.asarray(fit(s)).reshape(fit.noutputs, fit.ninputs, omega.size)
+        diag = np.array([resp[k, k] for k in range(fit.noutputs)])  # (1 or r) x nf
+        if diag.shape[0] == 1:
+            left[row:row + block.cols] = diag[0]
+            right[col:col + block.rows] = diag[0]
+        else:
+            left[row:row + block.cols] = diag
+            right[col:col + block.rows] = diag
+        row, col = row + block.cols, col + block.rows
+    scaled = left[:, None, :] * M / right[None, :, :]
+    return float(np.max(np.linalg.norm(np.moveaxis(scaled, -1, 0), ord=2, axis=(1, 2))))
+
+
+def _dense_grid(omega: np.ndarray, n: int, peak: float) -> np.ndarray:
+    base = np.logspace(np.log10(omega[0]), np.log10(omega[-1]), n)
+    near = peak * np.logspace(-0.15, 0.15, 41)  # resolve a sharp peak
+    return np.unique(np.concatenate([base, near, omega]))
+
+
+def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | None = None,
+          callback: Callable[[MusynIteration], None] | None = None,
+          rng: np.random.Generator | None = None) -> MusynResult:
+    """µ-synthesis by D-K iteration.
+
+    Parameters
+    ----------
+    P : control.StateSpace or GeneralizedPlant
+        Generalized plant with inputs ``[w; u]`` and outputs ``[z; y]``; ``w`` and ``z``
+        hold the uncertainty channels followed by the performance channels, in the order
+        of ``blk``.
+    nmeas, ncon : int
+        Number of measurements (last outputs) and controls (last inputs).
+    blk : array_like or BlockStructure
+        MATLAB-style block structure; the last block is usually the fictitious full
+        performance block. ``F_l(P, K)`` must be ``(Σ c_i) × (Σ r_i)``.
+    omega : array_like, optional
+        Design frequency grid, rad/s (default :func:`default_omega`).
+    options : MusynOptions, optional
+        Iteration bounds, stopping rules, K-step method, D-fit and reduction settings.
+    callback : callable, optional
+        Called with each :class:`MusynIteration` as soon as it is complete (progress).
+    rng : numpy.random.Generator, optional
+        Seeds the µ lower-bound restarts (default ``np.random.default_rng(0)``).
+
+    Returns
+    -------
+    MusynResult
+
+    Raises
+    ------
+    DimensionError
+        If ``blk`` does not fit the ``w``/``z`` partition of ``P``.
+    InfeasibleError
+        If the first K-step finds no stabilising controller.
+    """
+    from ..synthesis import hinfsyn
+    from .dfit import fit_dscales, scaled_plant
+
+    t_start = time.perf_counter()
+    opts = options if options is not None else MusynOptions()
+    rng = rng if rng is not None else np.random.default_rng(0)
+    G = GeneralizedPlant.from_statespace(P, nmeas, ncon)
+    struct = BlockStructure.coerce(blk)
+    if struct.shape_M != (G.nz, G.nw):
+        raise DimensionError(
+            f"block structure needs F_l(P, K) of size {struct.shape_M[0]}x{struct.shape_M[1]} "
+            f"(Σc x Σr); the plant's w -> z part is {G.nz}x{G.nw}")
+    dk_struct = _complexified(struct)
+    omega = default_omega(G) if omega is None else as_finite_array(omega, "omega").ravel()
+    if omega.size < 3 or np.any(omega <= 0) or np.any(np.diff(omega) <= 0):
+        raise ParameterError("omega must hold at least 3 strictly increasing positive frequencies")
+
+    PD = G.sys
+    history: list[MusynIteration] = []
+    best = None  # (mu_peak, K, index)
+    stop_reason = f"reached max_iter={opts.max_iter}"
+    since_best = 0
+    for it in range(1, int(opts.max_iter) + 1):
+        t0 = time.perf_counter()
+        try:
+            syn = hinfsyn(PD, nmeas, ncon, method=opts.method, options=opts.hinfsyn_options)
+        except LmiSuspensionError as exc:
+            if best is None:
+                raise
+            stop_reason = f"K-step failed at iteration {it}: {exc}"
+            logger.warning("musyn: %s; keeping iteration %d", stop_reason, best[2])
+            break
+        K = syn.K
+        t1 = time.perf_counter()
+        CL = lft(G, K)
+        if not np.all(np.real(CL.poles()) < 0):
+            if best is None:
+                raise InfeasibleError("the first K-step did not give a stabilising controller")
+            stop_reason = f"K-step at iteration {it} returned a non-stabilising controller"
+            break
+        mu = _mu_bounds(CL, dk_struct, omega, rng)
+        t2 = time.perf_counter()
+        upper, lower = np.asarray(mu.upper), np.asarray(mu.lower)
+        k_peak = int(np.argmax(upper))
+        mu_peak = float(upper[k_peak])
+
+        improved = best is None or mu_peak < best[0] * (1 - opts.min_improvement)
+        if best is None or mu_peak < best[0]:
+            best = (mu_peak, K, it)
+        since_best = 0 if improved else since_best + 1
+
+        done = None
+        if mu_peak < opts.mu_target:
+            done = f"µ peak {mu_peak:.4f} below target {opts.mu_target}"
+        elif since_best >= opts.patience:
+            done = f"no improvement of {opts.min_improvement:.1%} in {opts.patience} iterations"
+        elif it == opts.max_iter:
+            done = stop_reason
+
+        orders: tuple = ()
+        t3 = time.perf_counter()
+        if done is None:
+            # Emphasise the frequencies that set the peak: the fit matters most there.
+            weights = 0.2 + upper / mu_peak
+            M = _freqresp(CL, omega)
+            dfit = fit_dscales(omega, mu.d_blocks, max_order=opts.max_dfit_order,
+                               rtol=opts.dfit_rtol, weights=weights,
+                               mu_check=lambda fits: _scaled_peak(fits, M, omega, dk_struct),
+                               mu_peak=mu_peak)
+            orders = tuple(max(o) for o in dfit.orders)
+            PD = scaled_plant(G.sys, nmeas, ncon, dfit, _block_sizes(dk_struct))
+        t4 = time.perf_counter()
+        record = MusynIteration(
+            index=it, gamma=float(syn.gamma), mu_peak=mu_peak,
+            mu_lower_peak=float(np.max(lower)), peak_omega=float(omega[k_peak]),
+            dfit_orders=orders, controller_order=K.nstates, seconds_k=t1 - t0,
+            seconds_d=t2 - t1, seconds_fit=t4 - t3, warnings=tuple(syn.warnings))
+        history.append(record)
+        logger.info("musyn iteration %d: gamma=%.4f mu=%.4f (lower %.4f) K order %d "
+                    "D orders %s [K %.2fs, D %.2fs, fit %.2fs]", it, record.gamma, mu_peak,
+                    record.mu_lower_peak, K.nstates, orders, record.seconds_k,
+                    record.seconds_d, record.seconds_fit)
+        if callback is not None:
+            callback(record)
+        if done is not None:
+            stop_reason = done
+            break
+
+    mu_best, K, best_it = best
+    CL = lft(G, K)
+    dense = _dense_grid(omega, int(opts.n_dense), history[best_it - 1].peak_omega)
+    final = _mu_bounds(CL, struct, dense, rng)
+    reduced_from = None
+    if opts.reduce_order is not None and int(opts.reduce_order) < K.nstates:
+        K_red = _try_reduce(K, int(opts.reduce_order))
+        if K_red is not None:
+            CL_red = lft(G, K_red)
+            if np.all(np.real(CL_red.poles()) < 0):
+                final_red = _mu_bounds(CL_red, struct, dense, rng)
+                if np.max(final_red.upper) <= np.max(final.upper) * (1 + opts.reduce_mu_tol):
+                    reduced_from = K.nstates
+                    K, CL, final = K_red, CL_red, final_red
+                else:
+                    logger.info("musyn: reduced controller rejected (µ %.4f vs %.4f)",
+                                np.max(final_red.upper), np.max(final.upper))
+    upper = np.asarray(final.upper)
+    k_peak = int(np.argmax(upper))
+    return MusynResult(
+        K=K, CL=CL, mu_peak=float(upper[k_peak]), mu_lower_peak=float(np.max(final.lower)),
+        peak_omega=float(dense[k_peak]), mu=final, history=tuple(history),
+        best_iteration=best_it, stop_reason=stop_reason, reduced_from=reduced_from,
+        seconds=time.perf_counter() - t_start, omega=omega)
+
+
+def _try_reduce(K: control.StateSpace, order: int):
+    """Balanced truncation of the stable part (python-control ``balred``); None on failure."""
+    try:
+        return control.balred(K, order, method="truncate")
+    except Exception as exc:  # slycot raises plain ValueError/ArithmeticError variants
+        logger.info("musyn: order reduction to %d failed: %s", order, exc)
+        return None
