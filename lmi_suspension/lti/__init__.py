@@ -2,5 +2,6 @@
 
 from .checks import as_statespace
 from .plant import GeneralizedPlant, lft
+from .norms import hinfnorm
 
-__all__ = ["GeneralizedPlant", "lft", "as_statespace"]
+__all__ = ["GeneralizedPlant", "lft", "as_statespace", "hinfnorm"]

@@ -1,0 +1,124 @@
+"""Scaling of generalized plants before a solver sees them, and the map back.
+
+A plant with entries spanning many decades (the seat model mixes 1e-3 and 1e4) makes
+LMI solvers lose digits.  :func:`scale_plant` applies transformations that do not change
+the achievable closed-loop performance and records them so a controller designed for the
+scaled plant can be mapped back:
+
+* a diagonal state similarity ``x = T x_s`` (``scipy.linalg.matrix_balance`` of
+  ``[[A, B], [C, 0]]``, powers of two, so exact in floating point);
+* diagonal scalings of the controls ``u = Su u_s`` and measurements ``y_s = Sy y``,
+  absorbed by the controller: ``K = Su K_s Sy``;
+* one scalar on all disturbances ``w = cw w_s`` and one on all errors ``z_s = z / cz``,
+  which scale every closed-loop norm by the same factor: ``gamma_s = gamma cw / cz``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import control
+import numpy as np
+import scipy.linalg
+
+from .checks import as_statespace
+from .plant import GeneralizedPlant
+
+__all__ = ["PlantScaling", "scale_plant"]
+
+
+def _pow2(x):
+    # powers of two keep the scaling exact in floating point
+    x = np.asarray(x, dtype=float)
+    x = np.where(np.isfinite(x) & (x > 0), x, 1.0)
+    return np.exp2(np.round(np.log2(x)))
+
+
+@dataclass(frozen=True)
+class PlantScaling:
+    """Scalings applied by :func:`scale_plant` (all powers of two).
+
+    Attributes
+    ----------
+    T : numpy.ndarray
+        Diagonal of the state similarity ``x = diag(T) x_s``.
+    Su, Sy : numpy.ndarray
+        Diagonals of ``u = diag(Su) u_s`` and ``y_s = diag(Sy) y``.
+    cw, cz : float
+        ``w = cw w_s`` and ``z_s = z / cz``.
+    """
+
+    T: np.ndarray
+    Su: np.ndarray
+    Sy: np.ndarray
+    cw: float
+    cz: float
+
+    @property
+    def gamma_factor(self) -> float:
+        """``gamma_scaled / gamma_original`` for every closed loop."""
+        return self.cw / self.cz
+
+    def with_error_scale(self, P: GeneralizedPlant, factor: float
+                         ) -> tuple[GeneralizedPlant, "PlantScaling"]:
+        """Divide the errors of the already scaled ``P`` by ``factor`` (e.g. a first γ
+        estimate, so the next solve sees γ near 1); return the plant and the scaling."""
+        f = float(_pow2(factor))
+        b = P.blocks()
+        Ps = GeneralizedPlant.from_matrices(b["A"], b["B1"], b["B2"], b["C1"] / f, b["C2"],
+                                            b["D11"] / f, b["D12"] / f, b["D21"], b["D22"])
+        return Ps, replace(self, cz=self.cz * f)
+
+    def controller_to_original(self, Ks) -> control.StateSpace:
+        """Map a controller of the scaled plant back: ``K = Su K_s Sy``."""
+        Ks = as_statespace(Ks, "K")
+        Su, Sy = np.diag(self.Su), np.diag(self.Sy)
+        return control.ss(Ks.A, np.asarray(Ks.B) @ Sy, Su @ np.asarray(Ks.C),
+                          Su @ np.asarray(Ks.D) @ Sy)
+
+
+def scale_plant(P: GeneralizedPlant, *, states: bool = True, io: bool = True
+                ) -> tuple[GeneralizedPlant, PlantScaling]:
+    """Balance a generalized plant; return the scaled plant and the scaling.
+
+    Examples
+    --------
+    >>> from lmi_suspension.lti import GeneralizedPlant
+    >>> P = GeneralizedPlant.from_matrices(A=[[-1e3, 1e4], [0.0, -1e-2]], B1=[[0.0], [1.0]],
+    ...     B2=[[1e3], [0.0]], C1=[[1e-3, 0.0]], C2=[[0.0, 1e2]], D12=[[1.0]], D21=[[1.0]])
+    >>> Ps, sc = scale_plant(P)
+    >>> bool(abs(Ps.A).max() < abs(P.A).max())
+    True
+    """
+    b = P.blocks()
+    A = b["A"]
+    n = A.shape[0]
+    T = np.ones(n)
+    if states and n:
+        B = np.hstack([b["B1"], b["B2"]])
+        C = np.vstack([b["C1"], b["C2"]])
+        m = max(B.shape[1], C.shape[0])
+        M = np.zeros((n + m, n + m))
+        M[:n, :n] = A
+        M[:n, n:n + B.shape[1]] = B
+        M[n:n + C.shape[0], :n] = C
+        _, (scale, _perm) = scipy.linalg.matrix_balance(M, permute=False, separate=True)
+        T = _pow2(scale[:n])
+    Ti = 1.0 / T
+    A = Ti[:, None] * A * T[None, :]
+    B1, B2 = Ti[:, None] * b["B1"], Ti[:, None] * b["B2"]
+    C1, C2 = b["C1"] * T[None, :], b["C2"] * T[None, :]
+    D11, D12, D21, D22 = b["D11"], b["D12"], b["D21"], b["D22"]
+    Su, Sy, cw, cz = np.ones(P.nu), np.ones(P.ny), 1.0, 1.0
+    if io:
+        Su = _pow2(1.0 / np.linalg.norm(np.vstack([B2, D12, D22]), axis=0))
+        B2, D12 = B2 * Su[None, :], D12 * Su[None, :]
+        Sy = _pow2(1.0 / np.linalg.norm(np.hstack([C2, D21, D22 * Su[None, :]]), axis=1))
+        C2, D21 = Sy[:, None] * C2, Sy[:, None] * D21
+        D22 = Sy[:, None] * D22 * Su[None, :]
+        cw = float(_pow2(1.0 / np.linalg.norm(np.vstack([B1, D11, D21]), 2)))
+        cz = float(_pow2(np.linalg.norm(np.hstack([C1, D11 * cw, D12]), 2)))
+        B1, D11, D21 = B1 * cw, D11 * (cw / cz), D21 * cw
+        C1, D12 = C1 / cz, D12 / cz
+    Ps = GeneralizedPlant.from_matrices(A, B1, B2, C1, C2, D11, D12, D21, D22)
+    return Ps, PlantScaling(T=T, Su=Su, Sy=Sy, cw=cw, cz=cz)

@@ -1,0 +1,109 @@
+"""Structural checks of a generalized plant before H∞ synthesis."""
+
+from __future__ import annotations
+
+import control
+import numpy as np
+
+from ..errors import AssumptionError, InfeasibleError
+from ..lti.plant import GeneralizedPlant
+
+__all__ = ["check_stabilizable", "check_riccati_assumptions", "PBH_TOL", "RANK_TOL"]
+
+#: relative tolerance of the PBH rank tests (smallest singular value / matrix norm)
+PBH_TOL = 1e-9
+#: relative tolerance of the rank tests on D12, D21
+RANK_TOL = 1e-10
+#: relative distance to the imaginary axis below which an invariant zero counts as on it
+AXIS_TOL = 1e-8
+
+
+def _unstable_modes(A: np.ndarray) -> np.ndarray:
+    ev = np.linalg.eigvals(A)
+    return ev[ev.real >= -1e-12 * np.maximum(1.0, np.abs(ev))]
+
+
+def check_stabilizable(P: GeneralizedPlant) -> None:
+    """PBH tests: ``(A, B2)`` stabilisable and ``(C2, A)`` detectable.
+
+    Raises
+    ------
+    InfeasibleError
+        Naming the unstable mode that the controls cannot move or the measurements
+        cannot see; no controller stabilises such a plant.
+
+    Examples
+    --------
+    >>> from lmi_suspension.lti import GeneralizedPlant
+    >>> P = GeneralizedPlant.from_matrices(A=[[1.0, 0.0], [0.0, -1.0]], B1=[[1.0], [1.0]],
+    ...     B2=[[0.0], [1.0]], C1=[[1.0, 1.0]], C2=[[1.0, 1.0]], D12=[[1.0]], D21=[[1.0]])
+    >>> check_stabilizable(P)
+    Traceback (most recent call last):
+    ...
+    lmi_suspension.errors.InfeasibleError: (A, B2) is not stabilisable: the unstable mode s = 1 is uncontrollable from the controls u
+    """
+    A, B2, C2 = P.A, P.B2, P.C2
+    n = A.shape[0]
+    if n == 0:
+        return
+    scale_b = max(1.0, np.linalg.norm(np.hstack([A, B2]), 2))
+    scale_c = max(1.0, np.linalg.norm(np.vstack([A, C2]), 2))
+    for lam in _unstable_modes(A):
+        M = np.hstack([A - lam * np.eye(n), B2])
+        if np.linalg.svd(M, compute_uv=False)[-1] <= PBH_TOL * scale_b:
+            raise InfeasibleError(f"(A, B2) is not stabilisable: the unstable mode "
+                                  f"s = {_fmt(lam)} is uncontrollable from the controls u")
+        M = np.vstack([A - lam * np.eye(n), C2])
+        if np.linalg.svd(M, compute_uv=False)[-1] <= PBH_TOL * scale_c:
+            raise InfeasibleError(f"(C2, A) is not detectable: the unstable mode "
+                                  f"s = {_fmt(lam)} is unobservable from the measurements y")
+
+
+def _fmt(lam: complex) -> str:
+    return f"{lam.real:.6g}" if abs(lam.imag) == 0 else f"{lam:.6g}"
+
+
+def check_riccati_assumptions(P: GeneralizedPlant) -> None:
+    """Standing assumptions of the Riccati (DGKF / Glover-Doyle) solution.
+
+    1. ``D12`` has full column rank; 2. ``D21`` has full row rank;
+    3. ``[[A - jwI, B2], [C1, D12]]`` has full column rank for all real ``w``;
+    4. ``[[A - jwI, B1], [C2, D21]]`` has full row rank for all real ``w``.
+
+    Raises
+    ------
+    AssumptionError
+        Naming the first violated assumption.
+
+    Examples
+    --------
+    >>> from lmi_suspension.lti import GeneralizedPlant
+    >>> P = GeneralizedPlant.from_matrices(A=[[-1.0]], B1=[[1.0]], B2=[[1.0]],
+    ...     C1=[[1.0], [0.0]], C2=[[1.0]], D12=[[0.0], [1.0]], D21=[[0.0]])
+    >>> check_riccati_assumptions(P)
+    Traceback (most recent call last):
+    ...
+    lmi_suspension.errors.AssumptionError: D21 (1x1) must have full row rank 1 for the Riccati method (rank 0); use method='lmi' for singular problems
+    """
+    b = P.blocks()
+    for name, D, full, kind in (("D12", b["D12"], P.nu, "column"),
+                                ("D21", b["D21"], P.ny, "row")):
+        sv = np.linalg.svd(D, compute_uv=False)
+        rank = int(np.sum(sv > RANK_TOL * max(1.0, sv[0] if sv.size else 0.0)))
+        if D.shape[0 if kind == "column" else 1] < full or rank < full:
+            raise AssumptionError(
+                f"{name} ({D.shape[0]}x{D.shape[1]}) must have full {kind} rank {full} for "
+                f"the Riccati method (rank {rank}); use method='lmi' for singular problems")
+    # j-axis conditions: invariant zeros of (A, B2, C1, D12) and of (A, B1, C2, D21)
+    for label, sysargs in (
+            ("[[A - jwI, B2], [C1, D12]] must have full column rank for all w",
+             (b["A"], b["B2"], b["C1"], b["D12"])),
+            ("[[A - jwI, B1], [C2, D21]] must have full row rank for all w",
+             (b["A"], b["B1"], b["C2"], b["D21"]))):
+        if b["A"].shape[0] == 0:
+            continue
+        z = control.ss(*sysargs).zeros()
+        on_axis = z[np.abs(np.real(z)) <= AXIS_TOL * np.maximum(1.0, np.abs(z))]
+        if on_axis.size:
+            raise AssumptionError(f"{label}; it drops rank at s = {_fmt(complex(on_axis[0]))} "
+                                  "(an invariant zero on the imaginary axis)")

@@ -1,0 +1,272 @@
+"""Certified H∞ synthesis: LMI (Clarabel through CVXPY) or Riccati (python-control)."""
+
+from __future__ import annotations
+
+import logging
+import time
+
+import control
+import numpy as np
+
+from ..errors import (IllPosedLoopError, InfeasibleError, ParameterError,
+                      SolverError)
+from ..lti.checks import as_statespace
+from ..lti.norms import hinfnorm
+from ..lti.plant import GeneralizedPlant, lft
+from ..lti.scaling import PlantScaling, scale_plant
+from . import lmi as _lmi
+from .checks import check_riccati_assumptions, check_stabilizable
+from .result import HinfsynOptions, HinfsynResult, Timings
+
+__all__ = ["hinfsyn"]
+
+logger = logging.getLogger(__name__)
+
+#: the γ minimisation is repeated once when the scaled optimum lies outside this range,
+#: so the solver works with γ near 1
+_GAMMA_RANGE = (1.0 / 16.0, 16.0)
+
+
+def _as_plant(P, nmeas, ncon) -> GeneralizedPlant:
+    if isinstance(P, GeneralizedPlant):
+        return GeneralizedPlant.from_statespace(P, nmeas, ncon)
+    return GeneralizedPlant.from_statespace(as_statespace(P, "P"), nmeas, ncon)
+
+
+def _without_d22(P: GeneralizedPlant) -> GeneralizedPlant:
+    b = P.blocks()
+    b["D22"] = np.zeros_like(b["D22"])
+    return GeneralizedPlant.from_matrices(**b)
+
+
+def _undo_loop_shift(K0: control.StateSpace, D22: np.ndarray) -> control.StateSpace:
+    """``K = K0 (I + D22 K0)^-1``: the controller of the plant with its ``D22`` restored."""
+    if not np.any(D22):
+        return K0
+    Ak, Bk, Ck, Dk = (np.atleast_2d(np.asarray(m, dtype=float)) for m in (K0.A, K0.B, K0.C, K0.D))
+    nk = K0.nstates
+    Ak, Bk, Ck = Ak.reshape(nk, nk), Bk.reshape(nk, D22.shape[0]), Ck.reshape(D22.shape[1], nk)
+    W = np.eye(Dk.shape[0]) + Dk @ D22
+    if np.linalg.cond(W) > 1e12:
+        raise IllPosedLoopError("loop shifting: I + Dk D22 is singular; the controller "
+                                "for D22 = 0 cannot be mapped back")
+    Z = np.linalg.inv(W)
+    return control.ss(Ak - Bk @ D22 @ Z @ Ck, Bk @ (np.eye(D22.shape[0]) - D22 @ Z @ Dk),
+                      Z @ Ck, Z @ Dk)
+
+
+def _fastest_pole(K: control.StateSpace) -> float:
+    return float(np.max(np.abs(np.linalg.eigvals(K.A)))) if K.nstates else 0.0
+
+
+def _certify(G: GeneralizedPlant, K, gamma_solver: float, opts: HinfsynOptions,
+             warnings: list, what: str):
+    CL = lft(G, K)
+    gamma, _ = hinfnorm(CL)
+    poles = np.linalg.eigvals(CL.A) if CL.nstates else np.zeros(0, dtype=complex)
+    if not np.isfinite(gamma):
+        warnings.append(f"{what}: the closed loop is NOT stable (max Re pole = "
+                        f"{np.max(poles.real):.3g})")
+    elif gamma > gamma_solver * (1.0 + opts.cert_rtol):
+        warnings.append(f"{what}: certified gamma {gamma:.6g} exceeds the solver's bound "
+                        f"{gamma_solver:.6g} by {100 * (gamma / gamma_solver - 1):.3g} %")
+    return CL, float(gamma), poles
+
+
+def hinfsyn(P, nmeas: int, ncon: int, *, method: str = "lmi",
+            options: HinfsynOptions | None = None) -> HinfsynResult:
+    """Certified H∞ output-feedback synthesis.
+
+    Parameters
+    ----------
+    P : control.StateSpace or GeneralizedPlant
+        Continuous-time generalized plant; the controls are the last ``ncon`` inputs
+        and the measurements the last ``nmeas`` outputs (python-control's convention).
+    nmeas, ncon : int
+        Numbers of measurements and controls.
+    method : {"lmi", "riccati"}
+        ``"lmi"``: γ minimisation over the projected (elimination) LMIs, solved by
+        Clarabel through CVXPY, with a well-conditioned reconstruction at a slightly
+        relaxed γ; handles ``D11 != 0``, ``D22 != 0`` (loop shifting), unstable and
+        singular plants (rank-deficient ``D12`` / ``D21``).  ``"riccati"``:
+        python-control's ``hinfsyn`` (SLICOT ``sb10ad``) as a baseline, after checking
+        its standing assumptions.
+    options : HinfsynOptions, optional
+        Solver tolerances, fixed γ, relaxation; the caller's object is never changed.
+
+    Returns
+    -------
+    HinfsynResult
+        Unpacks as ``K, CL, gamma, info = hinfsyn(...)`` with ``info`` the result itself;
+        ``gamma`` is always the certified ``hinfnorm(lft(P, K))``.
+
+    Raises
+    ------
+    NonFiniteError, DiscreteTimeError, DimensionError
+        Invalid plant or partition.
+    InfeasibleError
+        No stabilising controller exists (uncontrollable/unobservable unstable mode),
+        or the fixed ``options.gamma`` is below the optimum.
+    AssumptionError
+        ``method="riccati"`` and a standing assumption fails.
+    SolverError
+        The solver failed after ``options.max_recoveries`` recoveries.
+
+    Examples
+    --------
+    Unstable plant ``1/(s - 1)`` with weighted control and a measurement noise:
+
+    >>> from lmi_suspension.lti import GeneralizedPlant
+    >>> from lmi_suspension.synthesis import hinfsyn
+    >>> P = GeneralizedPlant.from_matrices(A=[[1.0]], B1=[[1.0, 0.0]], B2=[[1.0]],
+    ...     C1=[[1.0], [0.0]], C2=[[1.0]], D12=[[0.0], [1.0]], D21=[[0.0, 1.0]])
+    >>> K, CL, gamma, info = hinfsyn(P, 1, 1)
+    >>> bool(info.stable), bool(gamma <= 1.005 * info.gamma_lower)
+    (True, True)
+    """
+    opts = HinfsynOptions() if options is None else options
+    if not isinstance(opts, HinfsynOptions):
+        raise ParameterError("options must be a HinfsynOptions instance")
+    if method not in ("lmi", "riccati"):
+        raise ParameterError(f"method must be 'lmi' or 'riccati', got {method!r}")
+    t0 = time.perf_counter()
+    G = _as_plant(P, nmeas, ncon)
+    # PBH tests on the balanced plant: the rank tolerance is relative to the matrix
+    # norm, which balancing keeps from being dominated by a few huge entries
+    check_stabilizable(scale_plant(G)[0])
+    if method == "riccati":
+        return _hinfsyn_riccati(G, opts, t0)
+    return _hinfsyn_lmi(G, opts, t0)
+
+
+# --------------------------------------------------------------------------- riccati
+def _hinfsyn_riccati(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> HinfsynResult:
+    check_riccati_assumptions(G)
+    warnings: list[str] = []
+    t1 = time.perf_counter()
+    try:
+        K, _CL, gam, _rcond = control.hinfsyn(G.sys, G.ny, G.nu)
+    except (ValueError, ArithmeticError, control.ControlArgument) as exc:
+        msg = str(exc)
+        low = msg.lower()
+        if any(k in low for k in ("gamma", "stabiliz", "riccati", "nonneg", "spectral")):
+            raise InfeasibleError(f"Riccati H∞ synthesis found no controller: {msg}") from exc
+        raise SolverError(f"Riccati H∞ synthesis (slycot sb10ad) failed: {msg}") from exc
+    except Exception as exc:  # slycot raises its own exception classes
+        if type(exc).__module__.startswith("slycot"):
+            raise SolverError(f"slycot sb10ad failed: {exc}") from exc
+        raise
+    t2 = time.perf_counter()
+    gam = float(gam)
+    CL, gamma, poles = _certify(G, K, gam, opts, warnings, "riccati")
+    if np.isfinite(gamma) and gamma > gam * 1.01:
+        warnings.append(f"riccati: controller is {100 * (gamma / gam - 1):.3g} % above "
+                        "its own gamma")
+    t3 = time.perf_counter()
+    return HinfsynResult(K=K, CL=CL, gamma=gamma, gamma_solver=gam, gamma_lower=None,
+                         poles=poles, status="optimal", method="riccati",
+                         timings=Timings(setup=t1 - t0, solve=t2 - t1, certify=t3 - t2),
+                         warnings=tuple(warnings), controller_fastest_pole=_fastest_pole(K))
+
+
+# --------------------------------------------------------------------------- lmi
+def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> HinfsynResult:
+    warnings: list[str] = []
+    G0 = _without_d22(G)
+    if opts.scale:
+        Ps, sc = scale_plant(G0)
+    else:
+        Ps, sc = G0, PlantScaling(np.ones(G0.nstates), np.ones(G0.nu), np.ones(G0.ny), 1.0, 1.0)
+    t_setup = time.perf_counter() - t0
+    t1 = time.perf_counter()
+    if opts.gamma is None:
+        sol = _lmi.gamma_lmi(Ps, opts)
+        if sol.gamma > opts.gamma_atol and not _GAMMA_RANGE[0] <= sol.gamma <= _GAMMA_RANGE[1]:
+            # re-solve with the errors scaled so that the solver sees gamma near 1
+            Ps, sc = sc.with_error_scale(Ps, sol.gamma)
+            sol = _lmi.gamma_lmi(Ps, opts)
+        warnings += list(sol.warnings)
+        gamma_lower: float | None = sol.gamma / sc.gamma_factor
+        relax = opts.gamma_relax
+        if sol.gamma <= opts.gamma_atol:
+            warnings.append(f"the LMI optimum is about 0 (below gamma_atol = {opts.gamma_atol:g} "
+                            "in scaled units); designing for gamma_atol instead")
+        # the target the reconstruction works towards, in scaled units
+        g_base = max(sol.gamma, opts.gamma_atol)
+    else:
+        gamma_lower = None
+        g_base = float(opts.gamma) * sc.gamma_factor
+        sol = _lmi.gamma_lmi(Ps, opts, gamma=g_base)
+        warnings += list(sol.warnings)
+        relax = 0.0
+    trace1 = float(np.trace(sol.R) + np.trace(sol.S)) if Ps.nstates else 0.0
+    if g_base != 1.0:
+        # errors scaled by 1/f so the reconstruction sees gamma near 1; in the γ-linear
+        # LMIs the γ-optimal (R, S) then scale by f, and so does their trace
+        f = float(np.exp2(np.round(np.log2(g_base))))
+        Ps, sc = sc.with_error_scale(Ps, g_base)
+        g_base, trace1 = g_base / f, trace1 * f
+    t_solve = time.perf_counter() - t1
+
+    t2 = time.perf_counter()
+    n = Ps.nstates
+    result = None
+    # the centring box: moderate (center_trace per state) so the centre stays well
+    # conditioned, or twice the trace of the γ-optimal solution if that is smaller (it
+    # is strictly feasible at the relaxed γ); enlarged tenfold on each recovery
+    trace_bound0 = min(2.0 * trace1, opts.center_trace * max(n, 1)) if trace1 > 0 \
+        else opts.center_trace * max(n, 1)
+    for attempt in range(int(opts.max_recoveries) + 1):
+        trace_bound = trace_bound0 * 10.0 ** attempt
+        g_ctrl = g_base * (1.0 + relax)
+        try:
+            if n == 0:
+                center = _lmi.LmiSolution(g_ctrl, np.zeros((0, 0)), np.zeros((0, 0)), "static")
+                Ks, cond_xy, cond_lyap = _lmi.explicit_controller(Ps, center, g_ctrl)
+            else:
+                Ks, cond_xy, cstatus, cwarn = _lmi.cov_controller(
+                    Ps, g_ctrl, opts, trace_bound)
+                center = _lmi.LmiSolution(g_ctrl, np.zeros((0, 0)), np.zeros((0, 0)),
+                                          cstatus, cwarn)
+                cond_lyap = float("nan")
+            K = _undo_loop_shift(sc.controller_to_original(Ks), G.D22)
+        except (InfeasibleError, SolverError, np.linalg.LinAlgError) as exc:
+            if attempt == opts.max_recoveries:
+                if opts.gamma is not None and isinstance(exc, InfeasibleError):
+                    raise
+                raise SolverError(f"controller reconstruction failed after "
+                                  f"{opts.max_recoveries} recoveries: {exc}") from exc
+            warnings.append(f"reconstruction attempt {attempt + 1} failed ({exc}); "
+                            "enlarging the trace bound")
+            if opts.gamma is None:
+                relax *= 1.6
+            continue
+        warnings += list(center.warnings)
+        tc = time.perf_counter()
+        att_warn: list[str] = []
+        g_ctrl_orig = g_ctrl / sc.gamma_factor
+        CL, gamma, poles = _certify(G, K, g_ctrl_orig, opts, att_warn, "lmi")
+        t_cert = time.perf_counter() - tc
+        result = (K, CL, gamma, poles, g_ctrl_orig, center.status, cond_xy, cond_lyap, t_cert)
+        if np.isfinite(gamma) and not att_warn:
+            break
+        if attempt < opts.max_recoveries:
+            warnings.append(f"reconstruction attempt {attempt + 1}: {'; '.join(att_warn)}; "
+                            "retrying with a larger trace bound and relaxed gamma")
+            if opts.gamma is None:
+                relax *= 1.6
+        else:
+            warnings += att_warn
+    K, CL, gamma, poles, g_ctrl, status, cond_xy, cond_lyap, t_cert = result
+    t_rec = time.perf_counter() - t2 - t_cert
+    if opts.gamma is None and gamma_lower is not None and np.isfinite(gamma) \
+            and gamma < gamma_lower * (1.0 - 1e-3):
+        warnings.append(f"certified gamma {gamma:.6g} is below the LMI optimum "
+                        f"{gamma_lower:.6g}: the γ minimisation was inaccurate")
+    return HinfsynResult(
+        K=K, CL=CL, gamma=gamma, gamma_solver=float(g_ctrl), gamma_lower=gamma_lower,
+        poles=poles, status=status, method="lmi",
+        timings=Timings(setup=t_setup, solve=t_solve, reconstruct=t_rec, certify=t_cert),
+        warnings=tuple(warnings), controller_fastest_pole=_fastest_pole(K),
+        cond_xy=cond_xy, cond_lyap=cond_lyap)
+

@@ -1,0 +1,348 @@
+"""Full-order H∞ synthesis by LMIs (projection lemma), solved by Clarabel through CVXPY.
+
+The existence of a controller with ``||F_l(P, K)||_∞ < γ`` (Gahinet & Apkarian 1994,
+Theorem 4.3; ``D22 = 0``) is equivalent to symmetric ``R`` and ``S`` with::
+
+    W_R^T [[A R + R A^T, R C1^T, B1], [C1 R, -γ I, D11], [B1^T, D11^T, -γ I]] W_R < 0
+    W_S^T [[A^T S + S A, S B1, C1^T], [B1^T S, -γ I, D11^T], [C1, D11, -γ I]] W_S < 0
+    [[R, I], [I, S]] >= 0
+
+with ``W_R = diag(N_R, I)``, ``N_R`` a basis of ``ker [B2^T D12^T]`` and
+``W_S = diag(N_S, I)``, ``N_S`` a basis of ``ker [C2 D21]``.  Only ``R``, ``S`` and γ
+are unknowns, which keeps the SDP small.  The outer factors are multiplied out by hand
+so CVXPY sees a few affine matrix products, symmetric by construction (``E + E^T``).
+
+Reconstruction: at a relaxed γ a second solve returns a central ``(R, S)`` (largest
+common slack of the three inequalities, bounded trace); the closed-loop Lyapunov matrix built from it is then well
+conditioned, and the controller matrices ``Ω = [[Ak, Bk], [Ck, Dk]]`` follow from the
+explicit all-solutions formula of the closed-loop bounded-real inequality, affine in
+``Ω`` for that fixed Lyapunov matrix (no third SDP).
+
+References
+----------
+P. Gahinet, P. Apkarian, "A linear matrix inequality approach to H∞ control",
+Int. J. Robust Nonlinear Control 4 (1994) 421-448.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+import control
+import cvxpy as cp
+import numpy as np
+import scipy.linalg
+
+from ..errors import InfeasibleError, SolverError
+from ..lti.plant import GeneralizedPlant
+from .result import HinfsynOptions
+
+__all__ = ["gamma_lmi", "center_xy", "explicit_controller", "cov_controller", "LmiSolution"]
+
+logger = logging.getLogger(__name__)
+
+_OK = (cp.OPTIMAL,)
+_INACCURATE = (cp.OPTIMAL_INACCURATE,)
+_INFEASIBLE = (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE)
+
+
+@dataclass(frozen=True)
+class LmiSolution:
+    """Solution of the elimination LMIs at level ``gamma`` (scaled plant)."""
+
+    gamma: float
+    R: np.ndarray
+    S: np.ndarray
+    status: str
+    warnings: tuple = ()
+
+
+def _null(M: np.ndarray) -> np.ndarray:
+    if M.shape[0] == 0:
+        return np.eye(M.shape[1])
+    return scipy.linalg.null_space(M, rcond=1e-10)
+
+
+def _sym(E):
+    return (E + E.T) / 2
+
+
+def _projected_lmis(P: GeneralizedPlant, R, S, gamma, margin):
+    """The two projected bounded-real LMIs as CVXPY constraints (``D22 = 0``)."""
+    b = P.blocks()
+    A, B1, B2, C1, C2 = b["A"], b["B1"], b["B2"], b["C1"], b["C2"]
+    D11, D12, D21 = b["D11"], b["D12"], b["D21"]
+    n, nw, nz = A.shape[0], B1.shape[1], C1.shape[0]
+    cons = []
+    NR = _null(np.hstack([B2.T, D12.T]))
+    if NR.shape[1]:
+        Nx, Nz = NR[:n], NR[n:]
+        F = Nx.T @ A + Nz.T @ C1
+        E = F @ R @ Nx
+        H = Nx.T @ B1 + Nz.T @ D11
+        k = NR.shape[1]
+        L = cp.bmat([[E + E.T - gamma * (Nz.T @ Nz), H], [H.T, -gamma * np.eye(nw)]])
+        cons.append(_sym(L) << -margin * np.eye(k + nw) if np.isscalar(margin)
+                    else _sym(L) + margin * np.eye(k + nw) << 0)
+    NS = _null(np.hstack([C2, D21]))
+    if NS.shape[1]:
+        Mx, Mw = NS[:n], NS[n:]
+        F = Mx.T @ A.T + Mw.T @ B1.T
+        E = F @ S @ Mx
+        H = Mx.T @ C1.T + Mw.T @ D11.T
+        k = NS.shape[1]
+        L = cp.bmat([[E + E.T - gamma * (Mw.T @ Mw), H], [H.T, -gamma * np.eye(nz)]])
+        cons.append(_sym(L) << -margin * np.eye(k + nz) if np.isscalar(margin)
+                    else _sym(L) + margin * np.eye(k + nz) << 0)
+    return cons
+
+
+def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
+    """Solve with explicit Clarabel settings; recover from inaccurate/failed solves.
+
+    Each recovery loosens the tolerances tenfold, doubles the iteration bound and
+    raises the static regularisation; every recovery is recorded in ``warnings``.
+    """
+    settings = opts.clarabel_settings()
+    attempts = [settings]
+    for i in range(int(opts.max_recoveries)):
+        kw = dict(settings)
+        f = 10.0 ** (i + 1)
+        kw.update(tol_gap_rel=settings["tol_gap_rel"] * f, tol_gap_abs=settings["tol_gap_abs"] * f,
+                  reduced_tol_gap_rel=min(1e-2, settings["reduced_tol_gap_rel"] * f),
+                  reduced_tol_gap_abs=min(1e-2, settings["reduced_tol_gap_abs"] * f),
+                  reduced_tol_feas=min(1e-4, settings["reduced_tol_feas"] * f),
+                  max_iter=int(settings["max_iter"]) * 2, static_regularization_constant=1e-7)
+        attempts.append(kw)
+    status = None
+    for k, kw in enumerate(attempts):
+        try:
+            prob.solve(solver=cp.CLARABEL, **kw)
+            status = prob.status
+        except cp.error.SolverError as exc:
+            status = f"solver_error: {exc}"
+        if status in _INFEASIBLE:
+            return status
+        if status in _OK or status in _INACCURATE:
+            if k:
+                warnings.append(f"{what}: recovered (attempt {k + 1}) with looser Clarabel "
+                                f"tolerances, status {status!r}")
+            elif status in _INACCURATE:
+                warnings.append(f"{what}: Clarabel status {status!r} (almost solved); "
+                                "the result is certified independently")
+            return status
+        logger.info("%s: Clarabel status %r, trying recovery %d", what, status, k + 1)
+    raise SolverError(f"{what}: Clarabel failed after {opts.max_recoveries} recoveries "
+                      f"(last status {status!r})", status=str(status))
+
+
+def gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None = None
+              ) -> LmiSolution:
+    """Minimise γ over the elimination LMIs (or test feasibility at fixed ``gamma``).
+
+    ``P`` must have ``D22 = 0`` and should be scaled.
+
+    Raises
+    ------
+    InfeasibleError
+        If no controller achieves the fixed ``gamma`` (or none stabilises ``P``).
+    SolverError
+        If Clarabel fails after ``opts.max_recoveries`` recoveries.
+    """
+    n = P.nstates
+    R = cp.Variable((n, n), symmetric=True)
+    S = cp.Variable((n, n), symmetric=True)
+    g = cp.Variable(nonneg=True) if gamma is None else float(gamma)
+    I = np.eye(n)
+    cons = _projected_lmis(P, R, S, g, opts.margin)
+    cons += [cp.bmat([[R, I], [I, S]]) >> 0,
+             cp.trace(R) + cp.trace(S) <= opts.xy_bound * n]
+    prob = cp.Problem(cp.Minimize(g) if gamma is None else cp.Minimize(0), cons)
+    warnings: list[str] = []
+    status = _solve(prob, opts, "gamma minimisation" if gamma is None else
+                    f"feasibility at gamma={gamma:.6g}", warnings)
+    if status in _INFEASIBLE:
+        if gamma is None:
+            raise InfeasibleError("the H∞ LMIs are infeasible for every γ: no stabilising "
+                                  "controller within the bound trace(X) + trace(Y) <= xy_bound n")
+        raise InfeasibleError(f"no controller achieves gamma = {gamma:.6g} "
+                              "(the H∞ LMIs are infeasible)")
+    gval = float(g.value) if gamma is None else float(gamma)
+    Rv, Sv = _sym(R.value), _sym(S.value)
+    if np.trace(Rv) + np.trace(Sv) > 0.99 * opts.xy_bound * n:
+        warnings.append(f"the bound trace(X) + trace(Y) <= {opts.xy_bound:g} n is active; "
+                        "the LMI optimum may be above the true infimum")
+    return LmiSolution(gval, Rv, Sv, str(status), tuple(warnings))
+
+
+def center_xy(P: GeneralizedPlant, gamma: float, opts: HinfsynOptions,
+              trace_bound: float) -> LmiSolution:
+    """A central ``(R, S)`` at fixed ``gamma`` for a well-conditioned reconstruction.
+
+    The near-optimal ``(R, S)`` of the γ minimisation sit on the boundary of the
+    feasible set (``R S -> I`` or ``R, S -> ∞``), which gives controllers with absurdly
+    fast poles.  At a relaxed ``gamma`` the feasible set has an interior; we take the
+    point with the largest common slack ``t`` of all three inequalities
+    (``L_R <= -t I``, ``L_S <= -t I``, ``[[R, I], [I, S]] >= t I``) inside the box
+    ``trace(R) + trace(S) <= trace_bound``: it keeps ``I - R S`` and the closed-loop
+    Lyapunov matrix well conditioned and leaves room for the explicit formula.
+    """
+    n = P.nstates
+    R = cp.Variable((n, n), symmetric=True)
+    S = cp.Variable((n, n), symmetric=True)
+    t = cp.Variable()
+    I = np.eye(n)
+    cons = _projected_lmis(P, R, S, float(gamma), t)
+    cons += [cp.bmat([[R, I], [I, S]]) >> t * np.eye(2 * n),
+             cp.trace(R) + cp.trace(S) <= trace_bound, t <= 1.0]
+    prob = cp.Problem(cp.Maximize(t), cons)
+    warnings: list[str] = []
+    status = _solve(prob, opts, f"reconstruction centring at gamma={gamma:.6g}", warnings)
+    if status in _INFEASIBLE or t.value is None or t.value <= 0:
+        raise InfeasibleError(f"no controller achieves gamma = {gamma:.6g} with "
+                              f"trace(X) + trace(Y) <= {trace_bound:.3g}")
+    return LmiSolution(float(gamma), _sym(R.value), _sym(S.value), str(status),
+                       tuple(warnings))
+
+
+def explicit_controller(P: GeneralizedPlant, sol: LmiSolution, gamma: float):
+    """Controller from ``(R, S)`` by the explicit solution of the closed-loop BRL.
+
+    With the closed-loop Lyapunov matrix fixed, the bounded-real inequality reads
+    ``Psi + U^T Omega V + V^T Omega^T U < 0``; one solution is
+    ``Omega = -rho U Phi V^T (V Phi V^T)^-1`` with ``Phi = (rho U^T U - Psi)^-1 > 0``
+    (Iwasaki & Skelton, Automatica 30 (1994) 1307-1317, all-solutions formula with
+    ``L = 0``).  ``rho`` is taken twice its smallest admissible value.
+    """
+    b = P.blocks()
+    A, B1, B2, C1, C2 = b["A"], b["B1"], b["B2"], b["C1"], b["C2"]
+    D11, D12, D21 = b["D11"], b["D12"], b["D21"]
+    n, nw, nu, nz, ny = P.nstates, P.nw, P.nu, P.nz, P.ny
+    R, S = sol.R, sol.S
+    U_, sv, Vt = np.linalg.svd(np.eye(n) - R @ S)
+    cond_xy = float(sv[0] / sv[-1]) if n and sv[-1] > 0 else float("inf")
+    M = U_ * np.sqrt(sv)[None, :]
+    N = Vt.T * np.sqrt(sv)[None, :]
+    lhs = np.block([[R, np.eye(n)], [M.T, np.zeros((n, n))]])
+    rhs = np.block([[np.eye(n), S], [np.zeros((n, n)), N.T]])
+    Xcl = np.linalg.solve(lhs.T, rhs.T).T
+    Xcl = (Xcl + Xcl.T) / 2
+    ev = np.linalg.eigvalsh(Xcl)
+    cond_lyap = float(ev[-1] / ev[0]) if ev[0] > 0 else float("inf")
+    A0 = np.block([[A, np.zeros((n, n))], [np.zeros((n, 2 * n))]])
+    B0 = np.block([[np.zeros((n, n)), B2], [np.eye(n), np.zeros((n, nu))]])
+    C0 = np.block([[np.zeros((n, n)), np.eye(n)], [C2, np.zeros((ny, n))]])
+    B10 = np.vstack([B1, np.zeros((n, nw))])
+    C10 = np.hstack([C1, np.zeros((nz, n))])
+    D0w = np.vstack([np.zeros((n, nw)), D21])
+    D0z = np.hstack([np.zeros((nz, n)), D12])
+    XA = Xcl @ A0
+    XB = Xcl @ B10
+    g = float(gamma)
+    Psi = np.block([[XA + XA.T, XB, C10.T],
+                    [XB.T, -g * np.eye(nw), D11.T],
+                    [C10, D11, -g * np.eye(nz)]])
+    U = np.hstack([B0.T @ Xcl, np.zeros((n + nu, nw)), D0z.T])
+    V = np.hstack([C0, D0w, np.zeros((n + ny, nz))])
+    # smallest rho with rho U^T U - Psi > 0: split along range(U^T) and its complement
+    Q, Rq = np.linalg.qr(U.T, mode="complete")
+    k = np.linalg.matrix_rank(U.T)
+    Psi_t = Q.T @ Psi @ Q
+    P11, P12, P22 = Psi_t[:k, :k], Psi_t[:k, k:], Psi_t[k:, k:]
+    if P22.size and np.linalg.eigvalsh(P22)[-1] >= 0:
+        raise SolverError("explicit reconstruction: projected inequality not negative "
+                          "definite (X, Y inaccurate)")
+    Sch = P11 - (P12 @ np.linalg.solve(P22, P12.T) if P22.size else 0)
+    G = Rq[:k, :] @ Rq[:k, :].T  # U U^T expressed in range coordinates
+    L = np.linalg.cholesky(G)
+    Li = np.linalg.inv(L)
+    rho_min = max(float(np.linalg.eigvalsh(Li @ ((Sch + Sch.T) / 2) @ Li.T)[-1]), 0.0)
+    rho = 2.0 * rho_min + 1e-6 * max(1.0, np.abs(Psi).max())
+    Phi = np.linalg.inv(rho * (U.T @ U) - Psi)
+    Phi = (Phi + Phi.T) / 2
+    VPV = V @ Phi @ V.T
+    Om = -rho * U @ Phi @ V.T @ np.linalg.inv((VPV + VPV.T) / 2)
+    Ak, Bk, Ck, Dk = Om[:n, :n], Om[:n, n:], Om[n:, :n], Om[n:, n:]
+    return control.ss(Ak, Bk, Ck, Dk), cond_xy, cond_lyap
+
+
+def cov_controller(P: GeneralizedPlant, gamma: float, opts: HinfsynOptions,
+                   trace_bound: float):
+    """A well-conditioned controller at fixed ``gamma`` from the change-of-variables LMI.
+
+    Scherer, Gahinet & Chilali (IEEE TAC 42 (1997) 896-911) make the closed-loop
+    bounded-real inequality affine in ``(X, Y, Â, B̂, Ĉ, D̂)``; the controller then
+    follows from those variables by exact formulas, so no second inequality has to be
+    solved for it.  Near the optimal γ the solution degenerates (``X -> Y⁻¹``, so
+    ``I - XY`` is singular and the controller gets absurdly fast poles).  At the given
+    (relaxed) ``gamma`` we therefore take the point of largest common slack ``t`` of the
+    bounded-real inequality (``<= -t I``) and of ``[[Y, I], [I, X]] >= t I`` inside
+    ``trace(X) + trace(Y) <= trace_bound``.
+
+    ``P`` must have ``D22 = 0`` and should be scaled.
+
+    Returns
+    -------
+    K : control.StateSpace
+    cond_xy : float
+        Condition number of ``I - XY``.
+    status : str
+    warnings : tuple of str
+    """
+    b = P.blocks()
+    A, B1, B2, C1, C2 = b["A"], b["B1"], b["B2"], b["C1"], b["C2"]
+    D11, D12, D21 = b["D11"], b["D12"], b["D21"]
+    n, nw, nu, nz, ny = P.nstates, P.nw, P.nu, P.nz, P.ny
+    X = cp.Variable((n, n), symmetric=True)
+    Y = cp.Variable((n, n), symmetric=True)
+    Ah = cp.Variable((n, n))
+    Bh = cp.Variable((n, ny))
+    Ch = cp.Variable((nu, n))
+    Dh = cp.Variable((nu, ny))
+    g = float(gamma)
+    # Lower block triangle of the inequality; the upper one is its transpose, so the
+    # matrix handed to the solver is symmetric by construction.
+    AY = A @ Y + B2 @ Ch
+    XA = X @ A + Bh @ C2
+    L11 = AY + AY.T
+    L21 = Ah + (A + B2 @ Dh @ C2).T
+    L22 = XA + XA.T
+    L31 = (B1 + B2 @ Dh @ D21).T
+    L32 = (X @ B1 + Bh @ D21).T
+    L41 = C1 @ Y + D12 @ Ch
+    L42 = C1 + D12 @ Dh @ C2
+    L43 = D11 + D12 @ Dh @ D21
+    L = cp.bmat([
+        [L11, L21.T, L31.T, L41.T],
+        [L21, L22, L32.T, L42.T],
+        [L31, L32, -g * np.eye(nw), L43.T],
+        [L41, L42, L43, -g * np.eye(nz)],
+    ])
+    size = 2 * n + nw + nz
+    I = np.eye(n)
+    # Largest common slack: a central point of the relaxed feasible set, which keeps
+    # I - XY away from singular and the controller variables moderate.
+    t = cp.Variable()
+    cons = [_sym(L) << -t * np.eye(size),
+            _sym(cp.bmat([[Y, I], [I, X]])) >> t * np.eye(2 * n),
+            cp.trace(X) + cp.trace(Y) <= trace_bound,
+            t <= 1.0]
+    prob = cp.Problem(cp.Maximize(t), cons)
+    warnings: list[str] = []
+    status = _solve(prob, opts, f"controller LMI at gamma={g:.6g}", warnings)
+    if status in _INFEASIBLE or t.value is None or t.value <= 0.0:
+        raise InfeasibleError(
+            f"no controller achieves gamma = {g:.6g} with trace(X) + trace(Y) <= "
+            f"{trace_bound:.3g}")
+    Xv, Yv = _sym(X.value), _sym(Y.value)
+    Ahv, Bhv, Chv, Dk = Ah.value, Bh.value, Ch.value, Dh.value
+    # N M^T = I - X Y with N = I; M^{-T} applied by solves, never by explicit inverses.
+    MT = np.eye(n) - Xv @ Yv
+    sv = np.linalg.svd(MT, compute_uv=False)
+    cond_xy = float(sv[0] / sv[-1]) if sv[-1] > 0 else float("inf")
+    Bk = Bhv - Xv @ B2 @ Dk
+    Ck = np.linalg.solve(MT.T, (Chv - Dk @ C2 @ Yv).T).T
+    inner = Ahv - Xv @ B2 @ Ck @ MT - Bk @ C2 @ Yv - Xv @ (A + B2 @ Dk @ C2) @ Yv
+    Ak = np.linalg.solve(MT.T, inner.T).T
+    return control.ss(Ak, Bk, Ck, Dk), cond_xy, str(status), tuple(warnings)

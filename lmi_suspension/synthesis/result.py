@@ -1,0 +1,167 @@
+"""Options and results of H∞ synthesis, shared by every method."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import control
+import numpy as np
+
+from ..errors import ParameterError
+
+__all__ = ["HinfsynOptions", "HinfsynResult", "Timings"]
+
+
+@dataclass(frozen=True)
+class HinfsynOptions:
+    """Options of :func:`~lmi_suspension.synthesis.hinfsyn` (frozen; copy with
+    :func:`dataclasses.replace`).
+
+    Attributes
+    ----------
+    gamma : float or None
+        Fixed performance level; ``None`` minimises γ (LMI method only).
+    gamma_relax : float
+        Relative relaxation of the LMI optimum used to reconstruct a well-conditioned
+        controller; the certified γ stays below ``(1 + gamma_relax) * gamma_lower``
+        up to solver accuracy.
+    gamma_atol : float
+        Absolute γ floor in scaled units (plant data normalised to about 1): when the LMI
+        optimum is below it (an infimum of 0, e.g. COMPleib AC1) the reconstruction
+        targets ``gamma_atol`` instead of a relative relaxation of 0.
+    tol_gap_abs, tol_gap_rel, tol_feas : float
+        Clarabel tolerances (passed explicitly).
+    reduced_tol_gap_abs, reduced_tol_gap_rel, reduced_tol_feas : float
+        Clarabel's "almost solved" tolerances: a solve that stalls within them is
+        accepted as ``optimal_inaccurate`` (reported in ``warnings``); γ only needs to
+        be accurate to a fraction of ``gamma_relax``.
+    max_iter : int
+        Clarabel iteration bound per solve.
+    margin : float
+        Strictness margin of the LMIs (``L <= -margin I``) in scaled data.
+    xy_bound : float
+        Bound ``trace(X) + trace(Y) <= xy_bound * n`` (scaled data) that keeps the γ
+        minimisation bounded; a warning says when it is active.
+    center_trace : float
+        Initial bound ``trace(X) + trace(Y) <= center_trace * n`` of the centring solve
+        (scaled data, γ normalised to 1); multiplied by 10 on each recovery.
+    max_recoveries : int
+        Number of recovery attempts (tightened tolerances, relaxed γ) after an
+        inaccurate or failed solve.
+    scale : bool
+        Balance states and normalise inputs/outputs before solving.
+    cert_rtol : float
+        Relative tolerance above which a disagreement between the certified γ and the
+        solver's own bound is reported in ``warnings``.
+    """
+
+    gamma: float | None = None
+    gamma_relax: float = 3e-3
+    gamma_atol: float = 1e-6
+    tol_gap_abs: float = 1e-7
+    tol_gap_rel: float = 1e-6
+    tol_feas: float = 1e-8
+    reduced_tol_gap_abs: float = 1e-4
+    reduced_tol_gap_rel: float = 5e-4
+    reduced_tol_feas: float = 1e-6
+    max_iter: int = 200
+    margin: float = 1e-8
+    xy_bound: float = 1e5
+    center_trace: float = 100.0
+    max_recoveries: int = 4
+    scale: bool = True
+    cert_rtol: float = 5e-3
+
+    def __post_init__(self):
+        if self.gamma is not None and not (np.isfinite(self.gamma) and self.gamma > 0):
+            raise ParameterError(f"gamma must be positive and finite, got {self.gamma!r}")
+        for name in ("gamma_relax", "gamma_atol", "tol_gap_abs", "tol_gap_rel", "tol_feas", "margin",
+                     "xy_bound", "center_trace", "cert_rtol", "reduced_tol_gap_abs",
+                     "reduced_tol_gap_rel", "reduced_tol_feas"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise ParameterError(f"{name} must be positive and finite, got {v!r}")
+        if int(self.max_iter) < 1 or int(self.max_recoveries) < 0:
+            raise ParameterError("max_iter must be >= 1 and max_recoveries >= 0")
+
+    def clarabel_settings(self) -> dict:
+        """Keyword arguments for ``problem.solve(solver=cvxpy.CLARABEL, ...)``."""
+        return dict(tol_gap_abs=self.tol_gap_abs, tol_gap_rel=self.tol_gap_rel,
+                    tol_feas=self.tol_feas, max_iter=int(self.max_iter),
+                    reduced_tol_gap_abs=self.reduced_tol_gap_abs,
+                    reduced_tol_gap_rel=self.reduced_tol_gap_rel,
+                    reduced_tol_feas=self.reduced_tol_feas)
+
+
+@dataclass(frozen=True)
+class Timings:
+    """Wall-clock seconds spent in each phase of a synthesis."""
+
+    setup: float = 0.0
+    solve: float = 0.0
+    reconstruct: float = 0.0
+    certify: float = 0.0
+
+    @property
+    def total(self) -> float:
+        return self.setup + self.solve + self.reconstruct + self.certify
+
+
+@dataclass(frozen=True)
+class HinfsynResult:
+    """Result of an H∞ synthesis.
+
+    Unpacks like python-control: ``K, CL, gamma, info = hinfsyn(...)``, where ``info``
+    is this result object itself.
+
+    Attributes
+    ----------
+    K : control.StateSpace
+        Controller from measurements ``y`` to controls ``u``.
+    CL : control.StateSpace
+        Closed loop ``lft(P, K)`` from ``w`` to ``z``.
+    gamma : float
+        Certified closed-loop H∞ norm, ``hinfnorm(CL)`` (``inf`` if not stable).
+    gamma_solver : float
+        The solver's own bound (the γ of the reconstruction LMI, or Riccati γ).
+    gamma_lower : float or None
+        LMI optimum: no controller of any order achieves less (up to solver accuracy).
+    poles : numpy.ndarray
+        Closed-loop poles.
+    status : str
+        Solver status of the last solve.
+    method : str
+        ``"lmi"`` or ``"riccati"``.
+    timings : Timings
+        Seconds per phase.
+    warnings : tuple of str
+        Recoveries and certificate disagreements, never silent.
+    controller_fastest_pole : float
+        Largest ``|p|`` over the controller poles (rad/s), 0 for a static controller.
+    cond_xy : float
+        Condition number of ``I - X Y`` used in the reconstruction (LMI method).
+    cond_lyap : float
+        Condition number of the closed-loop Lyapunov matrix (LMI method).
+    """
+
+    K: control.StateSpace
+    CL: control.StateSpace
+    gamma: float
+    gamma_solver: float
+    gamma_lower: float | None
+    poles: np.ndarray
+    status: str
+    method: str
+    timings: Timings = field(default_factory=Timings)
+    warnings: tuple = ()
+    controller_fastest_pole: float = 0.0
+    cond_xy: float = float("nan")
+    cond_lyap: float = float("nan")
+
+    def __iter__(self):
+        return iter((self.K, self.CL, self.gamma, self))
+
+    @property
+    def stable(self) -> bool:
+        """Whether the closed loop is internally stable."""
+        return bool(np.isfinite(self.gamma))

@@ -1,0 +1,103 @@
+"""Tests of lmi_suspension.lti.norms: hinfnorm (Hamiltonian iteration) and h2norm.
+
+Reference values: textbook closed forms (first- and second-order systems), dense
+frequency sweeps computed in the test (an independent route), python-control's
+``control.norm`` (slycot ab13dd / Lyapunov) as a second implementation.
+"""
+
+import control
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from lmi_suspension.errors import DiscreteTimeError, NonFiniteError, ParameterError
+from lmi_suspension.lti import hinfnorm
+from lmi_suspension.lti.norms import h2norm, is_stable, sigma_max
+
+
+def _random_stable(seed, n, m, p, with_d):
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((n, n))
+    A -= (np.max(np.linalg.eigvals(A).real) + rng.uniform(0.05, 1.0)) * np.eye(n)
+    D = rng.standard_normal((p, m)) if with_d else np.zeros((p, m))
+    return control.ss(A, rng.standard_normal((n, m)), rng.standard_normal((p, n)), D)
+
+
+@pytest.mark.parametrize("a", [0.1, 1.0, 25.0])
+def test_first_order_norm_is_one_over_a_at_dc(a):
+    # |1/(jw + a)| = 1/sqrt(w^2 + a^2), maximal at w = 0 (textbook identity)
+    gamma, omega = hinfnorm(control.tf([1.0], [1.0, a]))
+    assert gamma == pytest.approx(1.0 / a, rel=1e-9)
+    assert omega == 0.0
+
+
+@pytest.mark.parametrize("zeta, wn", [(0.05, 3.0), (0.2, 0.5), (0.01, 100.0)])
+def test_second_order_resonance_peak(zeta, wn):
+    # wn^2/(s^2 + 2 zeta wn s + wn^2): peak 1/(2 zeta sqrt(1 - zeta^2)) at wn sqrt(1 - 2 zeta^2)
+    gamma, omega = hinfnorm(control.tf([wn**2], [1.0, 2 * zeta * wn, wn**2]))
+    assert gamma == pytest.approx(1.0 / (2 * zeta * np.sqrt(1 - zeta**2)), rel=1e-8)
+    assert omega == pytest.approx(wn * np.sqrt(1 - 2 * zeta**2), rel=1e-4)
+
+
+def test_static_gain_and_peak_at_infinity():
+    D = np.array([[3.0, 4.0]])  # sigma_max = 5
+    assert hinfnorm(D) == (pytest.approx(5.0), 0.0)
+    # (2s + 1)/(s + 1): |G|^2 = (4w^2 + 1)/(w^2 + 1) increases to 4, sup at w = inf
+    gamma, omega = hinfnorm(control.tf([2.0, 1.0], [1.0, 1.0]))
+    assert gamma == pytest.approx(2.0, rel=1e-12)
+    assert omega == np.inf
+
+
+def test_unstable_and_marginal_systems_are_infinite():
+    assert hinfnorm(control.tf([1.0], [1.0, -1.0])) == (np.inf, 0.0)
+    gamma, omega = hinfnorm(control.tf([1.0], [1.0, 0.0, 4.0]))  # poles +-2j
+    assert gamma == np.inf and omega == pytest.approx(2.0)
+    assert not is_stable(control.tf([1.0], [1.0, 0.0]))
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_against_dense_sweep_and_python_control(seed):
+    rng = np.random.default_rng(100 + seed)
+    n, m, p = (int(v) for v in rng.integers(1, 12, size=3))
+    sys = _random_stable(seed, n, m, p, with_d=bool(seed % 2))
+    gamma, omega = hinfnorm(sys)
+    # independent route 1: a dense sweep never exceeds the norm, and the norm is
+    # attained at the reported frequency
+    w = np.concatenate([[0.0], np.logspace(-3, 3, 3000)])
+    assert sigma_max(sys, w).max() <= gamma * (1 + 1e-9)
+    assert sigma_max(sys, [omega])[0] == pytest.approx(gamma, rel=1e-12)
+    # independent route 2: python-control / slycot ab13dd (tolerance 1e-6 there)
+    ref = control.norm(sys, "inf", tol=1e-10, print_warning=False)
+    assert gamma == pytest.approx(ref, rel=1e-6)
+
+
+@settings(max_examples=15, deadline=None)
+@given(seed=st.integers(0, 2**31 - 1), n=st.integers(1, 10), m=st.integers(1, 4),
+       p=st.integers(1, 4), with_d=st.booleans())
+def test_property_matches_slycot(seed, n, m, p, with_d):
+    sys = _random_stable(seed, n, m, p, with_d)
+    gamma, omega = hinfnorm(sys)
+    assert gamma == pytest.approx(control.norm(sys, "inf", tol=1e-10, print_warning=False),
+                                  rel=1e-6)
+    assert sigma_max(sys, [omega])[0] == pytest.approx(gamma, rel=1e-12)
+
+
+def test_h2norm_identities_and_python_control():
+    # ||1/(s + a)||_2 = 1/sqrt(2a) (integral of 1/(w^2 + a^2) / (2 pi))
+    assert h2norm(control.tf([1.0], [1.0, 2.0])) == pytest.approx(0.5, rel=1e-12)
+    sys = _random_stable(7, 6, 2, 3, with_d=False)
+    assert h2norm(sys) == pytest.approx(control.norm(sys, 2), rel=1e-9)
+    assert h2norm(_random_stable(7, 6, 2, 3, with_d=True)) == np.inf
+    assert h2norm(control.tf([1.0], [1.0, -1.0])) == np.inf
+    assert h2norm(np.zeros((2, 2))) == 0.0
+
+
+def test_bad_input_raises_typed_errors():
+    with pytest.raises(NonFiniteError):
+        hinfnorm(control.ss([[np.nan]], [[1.0]], [[1.0]], [[0.0]]))
+    with pytest.raises(DiscreteTimeError):
+        hinfnorm(control.tf([1.0], [1.0, 0.5], dt=0.1))
+    with pytest.raises(ParameterError):
+        hinfnorm(control.tf([1.0], [1.0, 1.0]), rtol=0.0)
+    with pytest.raises(ValueError):  # typed errors are ValueErrors too
+        h2norm(control.tf([1.0], [1.0, 0.5], dt=True))
