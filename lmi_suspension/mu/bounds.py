@@ -295,7 +295,13 @@ def _fast_upper(M, struct, rl, cl, x0_list, opts: MussvOptions, H0=None):
     Er[rl < m - 1, rl[rl < m - 1]] = 1.0
     Ec[cl < m - 1, cl[cl < m - 1]] = 1.0
 
+    # Optimal scalings can run off to 0 or ∞ (a block decoupled from the rest, e.g. a
+    # zero row of M): the box keeps exp() finite; the bound stays certified because it is
+    # evaluated at exactly the clipped scaling that is returned.
+    box = 40.0
+
     def fun(x):
+        x = np.clip(x, -box, box)
         er, ec = np.exp(Er @ x), np.exp(-(Ec @ x))
         U, s, Vh = np.linalg.svd((er[:, None] * M) * ec[None, :])
         # Gradient of log σ̄ (valid where σ̄ is simple; BFGS copes with the kinks).
@@ -308,7 +314,7 @@ def _fast_upper(M, struct, rl, cl, x0_list, opts: MussvOptions, H0=None):
         if best is None or f0 < best[0]:
             best = (f0, x0[:-1], g0)
     x, f, H, _ = _bfgs(fun, best[1], best[0], best[2], H0, opts.fast_maxiter, opts.fast_gtol)
-    logd = np.append(x, 0.0)
+    logd = np.append(np.clip(x, -box, box), 0.0)
     # f is log σ̄ of exactly this D-scaled matrix: the bound is certified by construction.
     return float(np.exp(f)), logd, H
 

@@ -48,8 +48,9 @@ class MusynOptions:
         ``min_improvement`` over the best peak so far.
     min_improvement : float
         Relative improvement that counts as progress.
-    method : {"lmi", "riccati"}
-        K-step method of :func:`hinfsyn`.
+    method : {"lmi", "riccati", "best"}
+        K-step method of :func:`hinfsyn`; ``"best"`` runs both and keeps the controller
+        with the lower certified closed-loop γ.
     hinfsyn_options : HinfsynOptions or None
         Options passed to every K-step.
     max_dfit_order : int
@@ -82,8 +83,9 @@ class MusynOptions:
     def __post_init__(self):
         if int(self.max_iter) < 1 or int(self.patience) < 1:
             raise ParameterError("max_iter and patience must be >= 1")
-        if self.method not in ("lmi", "riccati"):
-            raise ParameterError(f"method must be 'lmi' or 'riccati', got {self.method!r}")
+        if self.method not in ("lmi", "riccati", "best"):
+            raise ParameterError(
+                f"method must be 'lmi', 'riccati' or 'best', got {self.method!r}")
         if not (self.mu_target >= 0 and self.min_improvement >= 0 and self.dfit_rtol > 0):
             raise ParameterError("mu_target, min_improvement must be >= 0 and dfit_rtol > 0")
         if int(self.max_dfit_order) < 0 or int(self.n_dense) < 10:
@@ -316,7 +318,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     for it in range(1, int(opts.max_iter) + 1):
         t0 = time.perf_counter()
         try:
-            syn = hinfsyn(PD, nmeas, ncon, method=opts.method, options=opts.hinfsyn_options)
+            syn = _k_step(hinfsyn, PD, nmeas, ncon, opts)
         except LmiSuspensionError as exc:
             if best is None:
                 raise
@@ -403,6 +405,25 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
         peak_omega=float(dense[k_peak]), mu=final, history=tuple(history),
         best_iteration=best_it, stop_reason=stop_reason, reduced_from=reduced_from,
         seconds=time.perf_counter() - t_start, omega=omega)
+
+
+def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions):
+    """H∞ synthesis on the scaled plant. With ``method="best"`` both the LMI and the
+    Riccati routes run and the controller with the lower *certified* γ is kept (each
+    route fails on problems the other solves: singular D12/D21 for Riccati, slow
+    near-integrator weights for the LMI)."""
+    if opts.method != "best":
+        return hinfsyn(PD, nmeas, ncon, method=opts.method, options=opts.hinfsyn_options)
+    results, errors = [], []
+    for method in ("lmi", "riccati"):
+        try:
+            results.append(hinfsyn(PD, nmeas, ncon, method=method,
+                                   options=opts.hinfsyn_options if method == "lmi" else None))
+        except LmiSuspensionError as exc:
+            errors.append(exc)
+    if not results:
+        raise errors[0]
+    return min(results, key=lambda r: r.gamma)
 
 
 def _try_reduce(K: control.StateSpace, order: int):
