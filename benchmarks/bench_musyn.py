@@ -1,0 +1,54 @@
+"""End-to-end µ-synthesis on the S&P distillation problem: LMI vs Riccati vs "best" K-step,
+and dkpy where installed, in one run.
+
+Run: ``python -m pytest benchmarks/bench_musyn.py -p no:cacheprovider``; the µ of each
+iteration is stored in ``benchmark.extra_info`` (``--benchmark-json`` keeps it).
+"""
+
+import time
+
+import numpy as np
+import pytest
+
+from lmi_suspension.examples import skogestad_distillation
+from lmi_suspension.mu import MusynOptions, musyn
+
+OMEGA = np.logspace(-3, 3, 61)  # the grid of dkpy's README example of this problem
+
+
+@pytest.mark.parametrize("method", ["riccati", "lmi", "best"])
+def test_bench_musyn_distillation(benchmark, method):
+    ex = skogestad_distillation()
+    res = benchmark.pedantic(
+        musyn, args=(ex.P, ex.nmeas, ex.ncon, ex.blk),
+        kwargs=dict(omega=OMEGA, options=MusynOptions(max_iter=4, method=method)),
+        rounds=1, iterations=1)
+    benchmark.extra_info["mu_per_iteration"] = [h.mu_peak for h in res.history]
+    benchmark.extra_info["gamma_per_iteration"] = [h.gamma for h in res.history]
+    benchmark.extra_info["mu_peak_dense"] = res.mu_peak
+    benchmark.extra_info["mu_lower_peak_dense"] = res.mu_lower_peak
+    assert res.mu_lower_peak <= res.mu_peak
+
+
+def test_bench_dkpy_distillation(benchmark):
+    dkpy = pytest.importorskip("dkpy")
+    eg = dkpy.example_skogestad2006_p325()
+    dk = dkpy.DkIterListOrder(
+        controller_synthesis=dkpy.HinfSynLmi(lmi_strictness=1e-7,
+                                             solver_params=dict(solver="CLARABEL")),
+        structured_singular_value=dkpy.SsvLmiBisection(
+            solver_params=dict(solver="CLARABEL")),
+        d_scale_fit=dkpy.DScaleFitSlicot(),
+        fit_orders=[4, 4, 4])
+
+    def run():
+        t0 = time.perf_counter()
+        try:
+            K, N, mu, info_fit, info = dk.synthesize(eg["P"], eg["n_y"], eg["n_u"], OMEGA,
+                                                     np.array([[1, 1], [1, 1], [2, 2]]))
+            return float(np.max(mu)), time.perf_counter() - t0, None
+        except Exception as exc:  # dkpy's own failures are part of the measurement
+            return float("nan"), time.perf_counter() - t0, f"{type(exc).__name__}: {exc}"
+
+    mu, seconds, error = benchmark.pedantic(run, rounds=1, iterations=1)
+    benchmark.extra_info.update(mu_peak=mu, seconds=seconds, error=error)
