@@ -27,8 +27,105 @@ def _cmd_model(args: argparse.Namespace) -> int:
     return 0
 
 
+def _progress(message: str) -> None:
+    sys.stderr.write(message + "\n")
+    sys.stderr.flush()
+
+
+def _cmd_reproduce(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .report.reproduce import comparison_table, reproduce
+
+    summary = reproduce(args.out, progress=_progress, rng=np.random.default_rng(args.seed),
+                        quick=args.quick)
+    sys.stdout.write(comparison_table(summary) + "\n")
+    return 0
+
+
+_ROADS = ("bump", "noise", "iso-C")
+
+
+def _road(name: str, seed: int, duration: float | None):
+    import numpy as np
+
+    from .report.reproduce import _NOISE_BAND_HZ, _NOISE_PSD
+    from .seat import bump, iso8608_road, white_noise
+
+    rng = np.random.default_rng(seed)
+    if name == "bump":
+        return bump(t_end=3.0 if duration is None else duration)
+    duration = 5.0 if duration is None else duration
+    if name == "noise":
+        return white_noise(duration, 1e-3, psd=_NOISE_PSD, bandwidth_hz=_NOISE_BAND_HZ, rng=rng)
+    return iso8608_road("C", 30.0, duration, 1e-3, rng=rng)
+
+
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    import dataclasses
+    import json
+    import math
+    from pathlib import Path
+
+    from .errors import InputError, ParameterError
+    from .io import load_controller
+    from .seat import closed_loop_stable, simulate
+
+    path = Path(args.controller)
+    if not path.is_file():
+        raise InputError(f"controller file {path} not found")
+    if not math.isfinite(args.delay) or args.delay < 0:
+        raise ParameterError(f"--delay must be a finite number of seconds >= 0, got {args.delay}")
+    if args.duration is not None and not (math.isfinite(args.duration) and args.duration > 0):
+        raise ParameterError(f"--duration must be a positive number of seconds, "
+                             f"got {args.duration}")
+    try:
+        K, _metadata = load_controller(path)
+    except (KeyError, TypeError, IndexError) as exc:
+        raise InputError(f"{path} is not a saved controller ({type(exc).__name__}: {exc})") \
+            from exc
+    road = _road(args.road, args.seed, args.duration)
+    res = simulate(K, road, delay=args.delay)
+    m = res.metrics()
+    linear = closed_loop_stable(K, args.delay)
+    if args.plot:
+        from .report.figures import plot_responses
+
+        fig = plot_responses({f"{path.name}, d = {args.delay * 1e3:g} ms": res}, "z3dd",
+                             title=road.description)
+        fig.savefig(args.plot, dpi=110)
+    if args.json:
+        data = {"controller": str(path), "road": road.description, "delay": args.delay,
+                "seed": args.seed, "stable_linear": linear, **dataclasses.asdict(m)}
+        data = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
+                for k, v in data.items()}
+        sys.stdout.write(json.dumps(data, indent=1) + "\n")
+        return 0
+    out = sys.stdout
+    out.write(f"controller {path} ({K.nstates} states), road: {road.description}, "
+              f"delay {args.delay * 1e3:g} ms\n")
+    rows = [("peak |z3''|", m.peak_z3dd, "m/s^2"), ("RMS z3''", m.rms_z3dd, "m/s^2"),
+            ("Wk-weighted RMS z3''", m.weighted_rms_z3dd, "m/s^2"),
+            ("VDV", m.vdv_z3dd, "m/s^1.75"), ("peak |x1|", m.peak_x1, "m"),
+            ("peak |u| applied", m.peak_u, "N"), ("time in saturation", m.saturation_time, "s")]
+    for label, value, unit in rows:
+        out.write(f"  {label:<22} {value:12.5g} {unit}\n")
+    out.write(f"  {'|x1| within z_max':<22} {'yes' if m.x1_within_limit else 'NO':>12} "
+              f"(z_max = {m.z_max} m)\n")
+    out.write(f"  {'stable (simulation)':<22} {'yes' if m.stable else 'NO':>12}\n")
+    out.write(f"  {'stable (Nyquist)':<22} {'yes' if linear else 'NO':>12}\n")
+    return 0
+
+
+class _Parser(argparse.ArgumentParser):
+    """Usage errors as one line (exit code 2), like every other error of the CLI."""
+
+    def error(self, message):
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="lmi-suspension",
         description="Robust active seat suspension: model, µ-synthesis, simulation.")
     parser.add_argument("-v", "--verbose", action="store_true", help="log progress details")
@@ -38,6 +135,28 @@ def build_parser() -> argparse.ArgumentParser:
     p_model.add_argument("--m3", type=float, default=None,
                          help="occupant upper-body mass in kg (default: Table 1, 43.3)")
     p_model.set_defaults(func=_cmd_model)
+
+    p_rep = sub.add_parser("reproduce", help="run the paper's study: µ design, comparison, "
+                           "simulations, figures, summary.json, controller.json")
+    p_rep.add_argument("--out", default="reproduce_out", help="output directory "
+                       "(default: ./reproduce_out)")
+    p_rep.add_argument("--quick", action="store_true",
+                       help="short runs and two delays (a smoke test, rough figures)")
+    p_rep.add_argument("--seed", type=int, default=0, help="seed of every random number (0)")
+    p_rep.set_defaults(func=_cmd_reproduce)
+
+    p_sim = sub.add_parser("simulate", help="simulate a saved controller on a road")
+    p_sim.add_argument("--controller", required=True, help="controller JSON (save_controller)")
+    p_sim.add_argument("--delay", type=float, default=0.0, help="actuator delay in seconds")
+    p_sim.add_argument("--road", choices=_ROADS, default="bump",
+                       help="bump (eq. 32), noise (white floor velocity) or iso-C "
+                            "(ISO 8608 class C at 30 km/h)")
+    p_sim.add_argument("--seed", type=int, default=0, help="seed of the random roads (0)")
+    p_sim.add_argument("--duration", type=float, default=None,
+                       help="length of the road record in seconds (bump 3, noise/iso-C 5)")
+    p_sim.add_argument("--plot", default=None, help="write the z3'' response to this PNG")
+    p_sim.add_argument("--json", action="store_true", help="print the metrics as JSON")
+    p_sim.set_defaults(func=_cmd_simulate)
     return parser
 
 
@@ -51,8 +170,10 @@ def main(argv: list[str] | None = None) -> int:
                         format="%(levelname)s %(name)s: %(message)s")
     try:
         return args.func(args)
-    except LmiSuspensionError as exc:
-        parser.exit(2, f"lmi-suspension: error: {exc}\n")
+    except (LmiSuspensionError, ValueError, OSError) as exc:
+        # One line, no traceback: bad files, bad numbers, solver failures.
+        message = " ".join(str(exc).split()) or type(exc).__name__
+        parser.exit(2, f"lmi-suspension: error: {message}\n")
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Callable
 
 import control
@@ -415,10 +415,14 @@ def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions):
     if opts.method != "best":
         return hinfsyn(PD, nmeas, ncon, method=opts.method, options=opts.hinfsyn_options)
     results, errors = [], []
+    from ..synthesis import HinfsynOptions
+
+    base = opts.hinfsyn_options if opts.hinfsyn_options is not None else HinfsynOptions()
     for method in ("lmi", "riccati"):
         try:
-            results.append(hinfsyn(PD, nmeas, ncon, method=method,
-                                   options=opts.hinfsyn_options if method == "lmi" else None))
+            # the Riccati candidate sees the balanced plant (its γ is certified anyway)
+            options = base if method == "lmi" else replace(base, riccati_scale=True)
+            results.append(hinfsyn(PD, nmeas, ncon, method=method, options=options))
         except LmiSuspensionError as exc:
             errors.append(exc)
     if not results:

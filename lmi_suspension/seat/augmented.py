@@ -376,10 +376,15 @@ def seat_augmented_plant(options: SeatDesignOptions | None = None,
             raise ParameterError(f"delay_max ({d_max}) must not be below delay_min ({d_min})")
         delay = delay_uncertainty(d_min, d_max, nominal=opts.delay_nominal,
                                   order=opts.delay_order, margin=opts.delay_margin)
-        # e^{-sd} u = N (u + p_delay), p_delay = δ W u
-        systems += [control.summing_junction(["u", "p_delay"], "u_sum", name="sum_u"),
+        # e^{-sd} u = N (u + p_delay), p_delay = δ W u.  The channel is scaled by u_max
+        # (q_delay = W u / u_max, the force enters as u_max p_delay): a constant D-scaling
+        # of the 1×1 block, so the Δ-set is unchanged, but the first K-step of D-K then
+        # sees the force error and the delay error in the same units instead of newtons.
+        systems += [_static(u_max, ["p_delay"], ["p_delay_N"], "delay_in_scale"),
+                    control.summing_junction(["u", "p_delay_N"], "u_sum", name="sum_u"),
                     control.ss(delay.N, inputs=["u_sum"], outputs=["u_act"], name="N_delay"),
-                    control.ss(delay.W, inputs=["u"], outputs=["q_delay"], name="W_delay")]
+                    control.ss(delay.W * (1.0 / u_max), inputs=["u"], outputs=["q_delay"],
+                               name="W_delay")]
         names = ["delay"] + names
         rows = [[1, 1]] + rows
         p_delay, q_delay = ["p_delay"], ["q_delay"]

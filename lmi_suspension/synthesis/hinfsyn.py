@@ -145,7 +145,14 @@ def _hinfsyn_riccati(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hi
     warnings: list[str] = []
     t1 = time.perf_counter()
     try:
-        K, _CL, gam, _rcond = control.hinfsyn(G.sys, G.ny, G.nu)
+        if opts.riccati_scale:
+            # Same balancing as the LMI route; the baseline proper (default) sees the
+            # plant exactly as the user gave it.
+            Gs, sc = scale_plant(G)
+            Ks, _CL, gam, _rcond = control.hinfsyn(Gs.sys, G.ny, G.nu)
+            K, gam = sc.controller_to_original(Ks), float(gam) / sc.gamma_factor
+        else:
+            K, _CL, gam, _rcond = control.hinfsyn(G.sys, G.ny, G.nu)
     except (ValueError, ArithmeticError, control.ControlArgument) as exc:
         msg = str(exc)
         low = msg.lower()

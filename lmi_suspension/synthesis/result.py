@@ -53,6 +53,10 @@ class HinfsynOptions:
     cert_rtol : float
         Relative tolerance above which a disagreement between the certified γ and the
         solver's own bound is reported in ``warnings``.
+    riccati_scale : bool
+        ``method="riccati"`` only: balance the plant (as the LMI route does) before
+        python-control sees it. Off by default so that the baseline is python-control
+        exactly as users call it.
     """
 
     gamma: float | None = None
@@ -71,6 +75,7 @@ class HinfsynOptions:
     max_recoveries: int = 4
     scale: bool = True
     cert_rtol: float = 5e-3
+    riccati_scale: bool = False
 
     def __post_init__(self):
         if self.gamma is not None and not (np.isfinite(self.gamma) and self.gamma > 0):

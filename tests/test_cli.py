@@ -1,0 +1,111 @@
+"""The ``lmi-suspension`` command line: ``model``, ``simulate`` and its error exits."""
+
+import json
+import subprocess
+import sys
+
+import control
+import numpy as np
+import pytest
+from matplotlib.image import imread
+
+from lmi_suspension.cli import main
+from lmi_suspension.io import save_controller
+from lmi_suspension.seat import bump, natural_modes, simulate
+
+
+@pytest.fixture(scope="module")
+def gain_file(tmp_path_factory):
+    # A static gain: u = 20 kN/m · x1, i.e. a spring in parallel with k1 (eq. 1 applies -u).
+    K = control.ss(np.zeros((0, 0)), np.zeros((0, 2)), np.zeros((1, 0)), [[20000.0, 0.0]])
+    path = tmp_path_factory.mktemp("cli") / "gain.json"
+    save_controller(path, K, inputs=["x1", "x3"], outputs=["u"])
+    return path
+
+
+def _json_run(capsys, *args):
+    assert main(["simulate", *map(str, args), "--json"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_model_still_works(capsys):
+    assert main(["model"]) == 0
+    out = capsys.readouterr().out
+    # the printed frequencies are those of natural_modes (an independent call)
+    for f_hz, _, _ in natural_modes():
+        assert f"{f_hz:9.3f}" in out
+
+
+def test_simulate_bump_matches_direct_simulation(capsys, gain_file):
+    data = _json_run(capsys, "--controller", gain_file, "--delay", 0.01, "--road", "bump")
+    direct = simulate(np.array([[20000.0, 0.0]]), bump(), delay=0.01).metrics()
+    assert data["peak_z3dd"] == pytest.approx(direct.peak_z3dd, rel=1e-12)
+    assert data["peak_u"] == pytest.approx(direct.peak_u, rel=1e-12)
+    assert data["stable"] and data["stable_linear"]
+    # and the text form prints the same number
+    assert main(["simulate", "--controller", str(gain_file), "--delay", "0.01"]) == 0
+    assert f"{direct.peak_z3dd:12.5g}" in capsys.readouterr().out
+
+
+def test_zero_controller_is_the_passive_seat(capsys, tmp_path):
+    path = tmp_path / "zero.json"
+    save_controller(path, control.ss([[-1.0]], [[1.0, 1.0]], [[0.0]], [[0.0, 0.0]]),
+                    inputs=["x1", "x3"], outputs=["u"])
+    data = _json_run(capsys, "--controller", path, "--road", "bump", "--duration", 1.5)
+    passive = simulate(None, bump(t_end=1.5)).metrics()
+    assert data["peak_z3dd"] == pytest.approx(passive.peak_z3dd,
+                                              rel=1e-12)
+    assert data["peak_u"] == 0.0
+
+
+@pytest.mark.parametrize("road", ["noise", "iso-C"])
+def test_random_roads_follow_the_seed(capsys, gain_file, road):
+    common = ("--controller", gain_file, "--road", road, "--duration", 1.0)
+    a = _json_run(capsys, *common, "--seed", 3)
+    b = _json_run(capsys, *common, "--seed", 3)
+    c = _json_run(capsys, *common, "--seed", 4)
+    assert a == b
+    assert a["rms_z3dd"] != c["rms_z3dd"] and a["rms_z3dd"] > 0
+    assert ("ISO 8608" in a["road"]) == (road == "iso-C")
+
+
+def test_simulate_writes_plot(capsys, gain_file, tmp_path):
+    png = tmp_path / "z.png"
+    assert main(["simulate", "--controller", str(gain_file), "--duration", "1",
+                 "--plot", str(png)]) == 0
+    img = imread(png)
+    assert img.shape[0] > 200 and np.mean(img[..., :3].min(axis=-1) < 0.8) > 0.01
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--controller", "{missing}"], "not found"),
+    (["--controller", "{gain}", "--road", "gravel"], "invalid choice"),
+    (["--controller", "{gain}", "--delay", "-0.01"], "delay"),
+    (["--controller", "{gain}", "--delay", "nan"], "delay"),
+    (["--controller", "{gain}", "--duration", "0"], "duration"),
+    (["--controller", "{bad}"], "not valid JSON"),
+    (["--controller", "{wrong}"], "not a saved controller"),
+])
+def test_errors_exit_2_with_one_line(capsys, gain_file, tmp_path, args, words):
+    bad = tmp_path / "bad.json"
+    bad.write_text("{not json")
+    wrong = tmp_path / "wrong.json"
+    wrong.write_text('{"inputs": ["x1", "x3"], "outputs": ["u"], "D": [[1.0, 2.0]], '
+                     '"A": [[-1.0]]}')  # B and C missing
+    names = {"missing": tmp_path / "nope.json", "gain": gain_file, "bad": bad, "wrong": wrong}
+    argv = ["simulate"] + [a.format(**names) for a in args]
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert words in err
+
+
+def test_console_error_has_no_traceback(tmp_path):
+    """Through the real interpreter entry point, not just main()."""
+    proc = subprocess.run([sys.executable, "-m", "lmi_suspension.cli", "simulate",
+                           "--controller", str(tmp_path / "missing.json")],
+                          capture_output=True, text=True, timeout=60, check=False)
+    assert proc.returncode == 2
+    assert proc.stderr.strip().count("\n") == 0 and "Traceback" not in proc.stderr

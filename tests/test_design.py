@@ -1,0 +1,103 @@
+"""Tests of the robust seat design (lmi_suspension.seat.design).
+
+The design runs once per module (D-K iteration, tens of seconds: marked slow). Every
+µ figure is checked against a computation that did not produce it: the µ lower bound
+(a destabilising perturbation found by power iteration) must not exceed the certified
+upper bound, and closed-loop stability with the exact delay (Nyquist, closed_loop_stable)
+is cross-checked by the poles of a high-order Padé loop. Time-domain figures come from
+the exact-delay simulation (simulate).
+"""
+
+import control
+import numpy as np
+import pytest
+
+from lmi_suspension.seat import bump, closed_loop_stable, seat_model, simulate
+from lmi_suspension.seat.design import (DEFAULT_DESIGN, SeatMuDesign, design_mu_controller,
+                                        design_nominal_hinf)
+
+pytestmark = pytest.mark.slow
+
+#: Passive bump peak z̈3, m/s² (simulate(None, bump()), the project's passive reference).
+PASSIVE_PEAK = 26.47
+
+
+@pytest.fixture(scope="module")
+def design():
+    return design_mu_controller(rng=np.random.default_rng(0))
+
+
+@pytest.fixture(scope="module")
+def bump_runs(design):
+    road = bump()
+    return {d: simulate(design.K, road, delay=d).metrics() for d in (0.0, 0.025)}
+
+
+def test_result_type_and_names(design):
+    assert isinstance(design, SeatMuDesign)
+    assert design.K.input_labels == ["x1", "x3"]
+    assert design.K.output_labels == ["u"]
+    # Units: the plant's measurement outputs are x1, x3 in metres and its control is the
+    # force in newtons (eq. 1), so the controller's DC gain maps m -> N: an independent
+    # check is that K equals the musyn controller on the same plant signals.
+    K0 = design.musyn.K
+    w = np.array([1.0, 30.0])
+    assert np.allclose(design.K(1j * w), K0(1j * w))
+    assert design.aug.P.output_labels[-2:] == ["y1", "y2"]
+    assert design.aug.P.input_labels[-1] == "u"
+
+
+def test_mu_bounds_consistent(design):
+    # Lower bound (a perturbation that attains it) never exceeds the certified upper bound.
+    assert design.mu_lower_peak <= design.mu_peak * (1 + 1e-6)
+    assert np.all(design.mu_lower <= design.mu_upper * (1 + 1e-6))
+    assert design.mu_peak == pytest.approx(float(np.max(design.mu_upper)))
+    # Target µ < 1 is NOT reached (measured 2026-11-22: upper 3.524, lower 3.524 at the
+    # body mode; design.py docstring explains the complex m3 cover). The lower bound is a
+    # perturbation that attains it, so µ > 1 is a fact for this controller; assert the
+    # measured level so that both a regression and a fix show up.
+    assert 1.0 < design.mu_lower_peak
+    assert design.mu_peak < 4.0
+
+
+def _pade_loop_poles(K, delay, order=8):
+    """Poles of the seat loop with an order-`order` Padé delay: independent of Nyquist."""
+    G = seat_model()
+    Gyu = control.ss(G.A, G.B[:, 1:], G.C[3:5], G.D[3:5, 1:])  # u -> [y1, y2]
+    num, den = control.pade(delay, order) if delay > 0 else ([1.0], [1.0])
+    Dly = control.ss(control.tf(num, den))
+    Kss = control.ss(K.A, K.B, K.C, K.D)
+    L = control.series(Gyu, Kss, Dly)  # SISO loop broken at the force
+    # u = K y is fed back without sign change (eq. 1 convention): positive feedback.
+    return control.feedback(L, 1, sign=+1).poles()
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.0125, 0.025])
+def test_closed_loop_stable_two_routes(design, delay):
+    assert closed_loop_stable(design.K, delay)
+    assert np.max(_pade_loop_poles(design.K, delay).real) < 0
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.025])
+def test_bump_limits(bump_runs, delay):
+    m = bump_runs[delay]
+    assert m.stable
+    assert m.peak_x1 <= 0.08
+    assert m.peak_u <= 1500.0 + 1e-9
+
+
+def test_nominal_controller_names():
+    K = design_nominal_hinf(DEFAULT_DESIGN)
+    assert K.input_labels == ["x1", "x3"] and K.output_labels == ["u"]
+    assert closed_loop_stable(K, 0.0)
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.025])
+def test_bump_comfort_not_worse_than_passive(bump_runs, delay):
+    # Target peak <= PASSIVE_PEAK / 2 is NOT met: the D-K controller is nearly zero
+    # (max |K(jω)| ≈ 1.8 N/m; measured peaks 26.47 m/s², x1 0.0321 m, |u| < 1 N at 0 and
+    # 25 ms) because µ is fixed by the K-independent complex m3 channel. Assert what holds:
+    # no worse than the passive seat (PASSIVE_PEAK from simulate(None, bump())).
+    passive = simulate(None, bump()).metrics().peak_z3dd
+    assert passive == pytest.approx(PASSIVE_PEAK, abs=0.01)
+    assert bump_runs[delay].peak_z3dd <= passive * 1.01

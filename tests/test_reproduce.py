@@ -1,0 +1,222 @@
+"""The reproduction pipeline writes every file, with consistent data, from a given design.
+
+The µ design itself is replaced by a fast stand-in (a fixed first-order controller and a
+two-record D-K history) so that these tests check the pipeline, not the synthesis.
+"""
+
+import dataclasses
+import importlib
+import json
+import math
+from types import SimpleNamespace
+
+import control
+import numpy as np
+import pytest
+from matplotlib.image import imread
+
+from lmi_suspension.errors import AssumptionError, ParameterError
+from lmi_suspension.io import load_controller
+from lmi_suspension.mu.dk import MusynIteration
+from lmi_suspension.seat import (
+    SeatDesignOptions,
+    bump,
+    bump_limit,
+    closed_loop_stable,
+    simulate,
+)
+
+R = importlib.import_module("lmi_suspension.report.reproduce")
+
+EXPECTED_PNGS = {
+    "fig07_bump.png", "fig08_white_noise.png", "fig09_bump_z3dd.png", "fig10_bump_x1.png",
+    "fig11_bump_u_applied.png", "fig12_noise_z3dd.png", "fig13_noise_x1.png",
+    "fig14_noise_u_applied.png", "fig15_mu_bounds.png", "peak_vs_delay.png", "iso_C_z3dd.png",
+}
+
+
+@dataclasses.dataclass(frozen=True)
+class _Design:
+    K: object
+    aug: object
+    musyn: object
+    mu_peak: float
+    mu_lower_peak: float
+    omega: np.ndarray
+    mu_upper: np.ndarray
+    mu_lower: np.ndarray
+    seconds: float
+
+
+def _stand_in(fail_riccati=False):
+    # Low-passed extra stiffness on x1 and a little on x3: a stable loop with a finite
+    # delay margin, unlike any µ design, so wrong wiring shows up in the numbers.
+    K_mu = control.ss([[-200.0]], [[200.0, 0.0]], [[15000.0]], [[0.0, 2000.0]])
+    history = tuple(
+        MusynIteration(index=i, gamma=1.5 / i, mu_peak=1.4 / i, mu_lower_peak=1.2 / i,
+                       peak_omega=12.0, dfit_orders=(2,), controller_order=1, seconds_k=0.0,
+                       seconds_d=0.0, seconds_fit=0.0) for i in (1, 2))
+    omega = np.logspace(-1, 3, 50)
+    upper = 0.4 + 0.3 * np.exp(-np.log(omega / 12.0) ** 2)
+    calls = []
+
+    def design_mu_controller(design=None, *, params=None, musyn_options=None, omega_=None,
+                             callback=None, rng=None):
+        calls.append(rng)
+        for rec in history:
+            if callback is not None:
+                callback(rec)
+        return _Design(K=K_mu, aug=SimpleNamespace(options=SeatDesignOptions()),
+                       musyn=SimpleNamespace(history=history), mu_peak=float(upper.max()),
+                       mu_lower_peak=float(0.9 * upper.max()), omega=omega, mu_upper=upper,
+                       mu_lower=0.9 * upper, seconds=0.0)
+
+    def design_nominal_hinf(design=None, *, params=None, method="lmi"):
+        if method == "riccati" and fail_riccati:
+            raise AssumptionError("stand-in: D12 rank deficient")
+        gain = 10000.0 if method == "lmi" else 25000.0
+        return control.ss([[-300.0]], [[300.0, 0.0]], [[gain]], [[0.0, 0.0]])
+
+    api = SimpleNamespace(design_mu_controller=design_mu_controller,
+                          design_nominal_hinf=design_nominal_hinf,
+                          DEFAULT_DESIGN=SeatDesignOptions(), DEFAULT_MUSYN=None)
+    return api, K_mu, history, calls
+
+
+# The quick run takes about 10 s (mostly matplotlib text layout); every test that uses it
+# is marked slow.
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    api, K_mu, history, calls = _stand_in()
+    out = tmp_path_factory.mktemp("reproduce")
+    messages = []
+    mp = pytest.MonkeyPatch()
+    mp.setattr(R, "_design_api", lambda: api)
+    try:
+        summary = R.reproduce(out, progress=messages.append, rng=np.random.default_rng(5),
+                              delays=(0.0, 0.01, 0.025), quick=True)
+    finally:
+        mp.undo()
+    return SimpleNamespace(summary=summary, out=out, messages=messages, K=K_mu,
+                           history=history, calls=calls)
+
+
+@pytest.mark.slow
+def test_every_file_is_written(run):
+    names = {p.name for p in run.out.iterdir()}
+    assert EXPECTED_PNGS | {"summary.json", "controller.json"} <= names
+    assert {p.name for p in run.summary.files} == names
+
+
+@pytest.mark.slow
+def test_pngs_are_nonempty_images(run):
+    for name in EXPECTED_PNGS:
+        path = run.out / name
+        assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        img = imread(path)
+        assert img.shape[0] > 200 and img.shape[1] > 400
+        # more than a blank canvas: some ink, in several colours (curves, limit lines)
+        rgb = img[..., :3]
+        assert np.mean(rgb.min(axis=-1) < 0.8) > 0.01
+        if name not in ("fig07_bump.png", "fig08_white_noise.png"):  # those are black only
+            assert np.sum(np.ptp(rgb, axis=-1) > 0.3) > 100
+
+
+@pytest.mark.slow
+def test_summary_has_every_controller_and_delay(run):
+    data = json.loads((run.out / "summary.json").read_text())
+    # quick=True keeps the first and last delay only
+    assert data["delays"] == [0.0, 0.025]
+    assert set(data["controllers"]) == set(R.CONTROLLER_NAMES)
+    limit = data["limit"]["peak"]
+    for name in R.CONTROLLER_NAMES:
+        entry = data["controllers"][name]
+        assert [row["delay"] for row in entry["per_delay"]] == data["delays"]
+        for row in entry["per_delay"]:
+            for road in ("bump", "noise"):
+                assert {"peak_z3dd", "rms_z3dd", "weighted_rms_z3dd", "vdv_z3dd", "peak_x1",
+                        "peak_u", "saturation_time", "stable"} <= set(row[road])
+            assert row["bump"]["ratio_to_limit"] == pytest.approx(
+                row["bump"]["peak_z3dd"] / limit, rel=1e-12)
+    assert len(data["mu"]["history"]) == len(run.history)
+    assert data["mu"]["history"][1]["mu_peak"] == run.history[1].mu_peak
+    assert data["mu"]["peak_upper"] == pytest.approx(max(data["mu"]["upper"]))
+    assert data["timings"]["total"] > 0
+    assert data["monte_carlo"]["n"] == len(data["monte_carlo"]["peak_z3dd"])
+
+
+@pytest.mark.slow
+def test_controller_json_round_trips_exactly(run):
+    K, meta = load_controller(run.out / "controller.json")
+    for name in "ABCD":
+        assert np.array_equal(np.asarray(getattr(K, name)), np.asarray(getattr(run.K, name)))
+    assert list(K.input_labels) == ["x1", "x3"] and list(K.output_labels) == ["u"]
+    assert meta["mu_peak_upper"] == run.summary.mu_peak
+    assert meta["mu_peak_lower"] == run.summary.mu_lower_peak
+    assert meta["design_options"]["acc_ref"] == SeatDesignOptions().acc_ref
+    assert meta["version"]
+
+
+@pytest.mark.slow
+def test_numbers_agree_with_direct_computations(run):
+    """Recompute a few reported figures by calling the simulator and the LP directly."""
+    s = run.summary
+    road = bump(t_end=R._QUICK.bump_t_end, dt=R._QUICK.road_dt)
+    direct = simulate(run.K, road, delay=0.025, dt=R._QUICK.sim_dt).metrics()
+    assert s.controller("mu").peak_z3dd[-1] == pytest.approx(direct.peak_z3dd, rel=1e-12)
+    passive = simulate(None, road, dt=R._QUICK.sim_dt).metrics()
+    assert s.controller("passive").peak_z3dd[0] == pytest.approx(passive.peak_z3dd, rel=1e-12)
+    # the limit is a lower bound for every controller (any force history is admissible)
+    assert s.limit_peak == pytest.approx(bump_limit(road, dt=R._QUICK.limit_dt).peak, rel=1e-6)
+    for c in s.controllers:
+        assert all(p >= s.limit_peak for p in c.peak_z3dd)
+
+
+@pytest.mark.slow
+def test_delay_margin_is_where_stability_is_lost(run):
+    c = run.summary.controller("hinf_riccati")
+    d = c.delay_margin
+    assert math.isfinite(d) and d > 0.025
+    # certificate by a different test (Nyquist count at fixed delays) on both sides
+    K = control.ss([[-300.0]], [[300.0, 0.0]], [[25000.0]], [[0.0, 0.0]])
+    assert closed_loop_stable(K, 0.98 * d) and not closed_loop_stable(K, 1.02 * d)
+    assert c.stable_on_interval
+
+
+@pytest.mark.slow
+def test_progress_reports_each_stage_and_iteration(run):
+    text = "\n".join(run.messages)
+    for rec in run.history:
+        assert f"D-K iteration {rec.index}:" in text
+    for word in ("µ design", "limit", "Monte-Carlo", "ISO 8608", "figures"):
+        assert word in text
+    assert isinstance(run.calls[0], np.random.Generator)
+
+
+@pytest.mark.slow
+def test_comparison_table_lists_every_controller(run):
+    table = R.comparison_table(run.summary)
+    for long_name in R._LONG_NAMES.values():
+        assert long_name in table
+    assert f"{run.summary.limit_peak:.3f}" in table
+
+
+def test_bad_delays_fail_before_any_design(monkeypatch, tmp_path):
+    monkeypatch.setattr(R, "_design_api", lambda: pytest.fail("design must not run"))
+    for bad in ([], [-0.01], [float("nan")], ["x"]):
+        with pytest.raises(ParameterError):
+            R.reproduce(tmp_path, delays=bad, quick=True)
+    with pytest.raises(ParameterError):
+        R.reproduce(tmp_path, rng=42, quick=True)
+
+
+@pytest.mark.slow
+def test_failed_comparison_design_is_recorded(monkeypatch, tmp_path):
+    api, *_ = _stand_in(fail_riccati=True)
+    monkeypatch.setattr(R, "_design_api", lambda: api)
+    summary = R.reproduce(tmp_path, rng=np.random.default_rng(0), delays=(0.0,), quick=True)
+    data = json.loads((tmp_path / "summary.json").read_text())
+    assert "AssumptionError" in data["controllers"]["hinf_riccati"]["error"]
+    assert summary.controller("hinf_riccati").error
+    assert "design failed" in R.comparison_table(summary)
+    assert (tmp_path / "peak_vs_delay.png").stat().st_size > 0
