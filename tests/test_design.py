@@ -93,11 +93,10 @@ def test_nominal_controller_names():
 
 
 @pytest.mark.parametrize("delay", [0.0, 0.025])
-def test_bump_comfort_not_worse_than_passive(bump_runs, delay):
-    # Target peak <= PASSIVE_PEAK / 2 is NOT met: the D-K controller is nearly zero
-    # (max |K(jω)| ≈ 1.8 N/m; measured peaks 26.47 m/s², x1 0.0321 m, |u| < 1 N at 0 and
-    # 25 ms) because µ is fixed by the K-independent complex m3 channel. Assert what holds:
-    # no worse than the passive seat (PASSIVE_PEAK from simulate(None, bump())).
+def test_bump_comfort_half_of_passive(bump_runs, delay):
+    """Issue 6 target: peak z̈3 on the bump at most half the passive peak (measured
+    2026-11-22: 8.7 m/s² at 0 ms, 12.7 m/s² at 25 ms; passive 26.47 from an independent
+    simulate(None, bump()) in this test)."""
     passive = simulate(None, bump()).metrics().peak_z3dd
     assert passive == pytest.approx(PASSIVE_PEAK, abs=0.01)
-    assert bump_runs[delay].peak_z3dd <= passive * 1.01
+    assert bump_runs[delay].peak_z3dd <= passive / 2

@@ -66,6 +66,10 @@ class SeatDesignOptions:
         Deflection scale of eq. (13), m; ``None`` takes ``params.z_max``.
     w_scale : float
         Floor-velocity scale, m/s (default: the bump's peak ż0, :data:`BUMP_PEAK_VELOCITY`).
+    w_corner : float or None
+        If set (rad/s), the floor velocity is shaped ``w_scale s/(s + w_corner)``: below
+        the corner a unit ``w`` means a floor *displacement* of ``w_scale/w_corner``
+        (e.g. the bump height) instead of an ever larger stroke.
     noise : tuple of float
         Sensor-noise scales on ``y = [x1, x3]``, m.
     include_delay, include_parametric, include_paper : bool
@@ -102,6 +106,7 @@ class SeatDesignOptions:
     force_rolloff_corner: float = 2 * math.pi * 30.0
     z_max: float | None = None
     w_scale: float = BUMP_PEAK_VELOCITY
+    w_corner: float | None = None
     noise: tuple[float, float] = (5e-4, 5e-4)
     include_delay: bool = True
     include_parametric: bool = True
@@ -354,7 +359,9 @@ def seat_augmented_plant(options: SeatDesignOptions | None = None,
     core, nominal, names, rows, p_par, q_par, p_nb, q_nb = _core(params, opts)
 
     systems = [core,
-               _static(opts.w_scale, ["w"], ["zdot0"], "w_scale"),
+               (_static(opts.w_scale, ["w"], ["zdot0"], "w_scale") if opts.w_corner is None
+                else control.ss(control.tf([opts.w_scale, 0.0], [1.0, opts.w_corner]),
+                                inputs=["w"], outputs=["zdot0"], name="w_scale")),
                control.ss(wk_weight(opts.wk_order, acc_ref=opts.acc_ref),
                           inputs=["z3dd"], outputs=["e_acc"], name="W_acc"),
                _static(1.0 / z_max, ["x1"], ["e_defl"], "W_defl"),

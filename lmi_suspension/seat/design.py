@@ -7,14 +7,16 @@ norm-bounded blocks, and re-evaluates µ of the returned controller on a dense g
 :func:`design_nominal_hinf` is the comparison controller: H∞ on the same performance
 weights with an ideal actuator and no uncertainty.
 
-Status of the tuning (measured, see tests/test_design.py): µ < 1 is NOT reached. The
-complex cover (``parametric_complex=True``, needed by mussv's fast path) of the real
-m3 ∈ [30, 70] kg uncertainty acts on the lightly damped upper-body mode (≈ 12.8 rad/s):
-the µ lower bound equals the upper bound there (≈ 3.0 with acc_ref = 150, ≈ 3.3 with 40)
-for the passive seat and for every D-K controller tried, i.e. a complex m3 perturbation of
-a third of the range destabilises the body mode whatever the seat force does. The mixed
-(real) µ is smaller (≈ 2.1 for the passive seat at acc_ref = 40) but mussv's mixed path
-needs ≈ 145 s for 80 frequencies. The defaults below are the fastest stable design.
+Status of the tuning (measured 2026-11-22, see tests/test_design.py and the notes of
+issue 6): µ < 1 is NOT reached. The default design keeps the delay cover (0–25 ms) in the
+synthesis and reaches a µ peak of about 1.6 (upper = lower bound) on that structure; on the
+bump it gives peak z̈3 ≈ 8.7 / 9.9 / 12.7 m/s² at 0 / 10 / 25 ms (passive 26.5, half
+passive 13.2, physical limit ≈ 6.2) with a delay margin of ≈ 0.2 s. Two uncertainty
+channels are left out of the synthesis because they defeat the K-step: the complex cover
+of the occupant mass m3 ∈ [30, 70] kg destabilises the lightly damped body mode
+(µ ≈ 3.5 whatever the controller), and the paper's norm-bounded blocks, with the
+reconstructed E_B, make the first K-step choose K ≈ 0. Occupant-mass and stiffness
+variation is checked instead by Monte-Carlo simulation (reproduce).
 """
 
 from __future__ import annotations
@@ -37,29 +39,32 @@ logger = logging.getLogger(__name__)
 
 #: Weights of the robust design.
 DEFAULT_DESIGN = SeatDesignOptions(
-    # Wk-weighted z̈3 of 40 m/s² per unit w: with acc_ref = 10 the passive seat alone has a
-    # weighted gain of 4.2 and no controller brings µ near 1; 40 puts the passive nominal
-    # performance at about 1.05, so µ measures what the uncertainty costs.
-    acc_ref=40.0,
+    # Wk-weighted z̈3 of 3 m/s² per unit w: aggressive comfort; with the force and
+    # deflection channels each near their limits the stacked H∞ norm is ≈ 1.6.
+    acc_ref=3.0,
     # Second-order Wk: the fourth-order fit's slow poles make the LMI K-step's controller
     # reconstruction fail (SolverError) even on the nominal plant; order 2 solves.
     wk_order=2,
     # 0.5 mm sensor noise on x1, x3 (per unit n): small next to the 3 cm bump deflection,
     # and it keeps D21 full rank (regular H∞ problem).
     noise=(5e-4, 5e-4),
-    # Static force weight 1/u_max: the delay weight already limits the bandwidth above
-    # ~1/(25 ms), a roll-off would add a state to every K-step plant.
+    # Floor velocity 0.65 m/s per unit w, shaped s/(s + 6.5): a sustained sinusoid of
+    # the bump's full peak velocity (1.31 m/s) at the worst frequency asks for more force
+    # and stroke than the 0.24 s bump ever does; below 6.5 rad/s a unit w is a 0.1 m
+    # floor displacement (the bump height), not an unbounded stroke.
+    w_scale=0.65,
+    w_corner=6.5,
     force_rolloff_ratio=1.0,
-    # mussv's fast path needs full complex blocks; µ is then an upper bound of the mixed µ.
+    # Synthesised uncertainty: the delay cover only (see the module docstring).
+    include_parametric=False,
+    include_paper=False,
     parametric_complex=True,
 )
 
-#: D-K settings: LMI K-step (certified, ≈ 20 s per step on the 11-state plant here;
-#: the Riccati route reports wrong γ on this plant and "best" doubles the time).
-#: Constant D-scales (order 0): with first-order fits the six-block scaled plant's second
-#: K-step took > 2 min, and neither order improved µ (it is set by the complex m3 cover,
-#: see the module docstring). Two iterations bound the design to well under 60 s.
-DEFAULT_MUSYN = MusynOptions(method="lmi", max_iter=2, patience=1, max_dfit_order=0,
+#: D-K settings: each K-step runs the LMI and the (balanced) Riccati route and keeps the
+#: lower certified γ; constant D-scales (order-2 fits did not lower µ and double the
+#: K-step time); three iterations keep the design within ≈ 30–50 s on this machine.
+DEFAULT_MUSYN = MusynOptions(method="best", max_iter=3, patience=1, max_dfit_order=0,
                              n_dense=120)
 
 #: Design grid, rad/s: 0.1 rad/s (below the Wk band) to ≈ 3000 rad/s (above 1/(25 ms)).
@@ -135,7 +140,7 @@ def design_mu_controller(design: SeatDesignOptions | None = None, *,
     Examples
     --------
     >>> from lmi_suspension.seat.design import DEFAULT_DESIGN
-    >>> DEFAULT_DESIGN.include_delay and DEFAULT_DESIGN.include_parametric
+    >>> DEFAULT_DESIGN.include_delay and not DEFAULT_DESIGN.include_parametric
     True
     """
     t0 = time.perf_counter()
@@ -159,7 +164,7 @@ def design_mu_controller(design: SeatDesignOptions | None = None, *,
 
 def design_nominal_hinf(design: SeatDesignOptions | None = None, *,
                         params: SeatParameters | None = None,
-                        method: str = "lmi") -> control.StateSpace:
+                        method: str = "best") -> control.StateSpace:
     """Nominal H∞ controller for the same performance weights (no delay, no uncertainty).
 
     Parameters
@@ -167,8 +172,11 @@ def design_nominal_hinf(design: SeatDesignOptions | None = None, *,
     design : SeatDesignOptions, optional
         Weights (default :data:`DEFAULT_DESIGN`); the ``include_*`` flags are switched off.
     params : SeatParameters, optional
-    method : {"lmi", "riccati"}
-        K-step of :func:`~lmi_suspension.synthesis.hinfsyn` ("riccati": python-control).
+    method : {"best", "lmi", "riccati"}
+        Route of :func:`~lmi_suspension.synthesis.hinfsyn` ("riccati": python-control as
+        users call it). "best" tries the LMI and, if its reconstruction fails on this
+        plant (it does with the default weights, measured 2026-11-22), takes the balanced
+        Riccati controller; either way γ is the certified closed-loop norm.
 
     Returns
     -------
@@ -188,5 +196,21 @@ def design_nominal_hinf(design: SeatDesignOptions | None = None, *,
     nominal = replace(design, include_delay=False, include_parametric=False,
                       include_paper=False)
     aug = seat_augmented_plant(nominal, params)
-    res = hinfsyn(aug.P, aug.nmeas, aug.ncon, method=method)
+    from ..synthesis import HinfsynOptions
+
+    # A 5 % γ relaxation: with the default 0.3 % the well-conditioned reconstruction of
+    # this plant fails (measured), and a comparison controller need not be γ-optimal.
+    from ..errors import LmiSuspensionError
+
+    if method != "best":
+        options = HinfsynOptions(gamma_relax=0.05) if method == "lmi" else None
+        return _named(hinfsyn(aug.P, aug.nmeas, aug.ncon, method=method, options=options).K)
+    try:
+        res = hinfsyn(aug.P, aug.nmeas, aug.ncon, method="lmi",
+                      options=HinfsynOptions(gamma_relax=0.05))
+    except LmiSuspensionError as exc:
+        logger.warning("nominal H∞: LMI route failed (%s); using the balanced Riccati route",
+                       exc)
+        res = hinfsyn(aug.P, aug.nmeas, aug.ncon, method="riccati",
+                      options=HinfsynOptions(riccati_scale=True))
     return _named(res.K)
