@@ -2,7 +2,7 @@
 
 Run: ``python benchmarks/compleib_table.py`` (needs ../shared/data beside the checkout).
 """
-import json, time, warnings, numpy as np
+import json, time, warnings
 warnings.simplefilter("ignore")
 from lmi_suspension.lti import GeneralizedPlant
 from lmi_suspension.synthesis import hinfsyn
