@@ -7,9 +7,11 @@ import numbers
 import control
 import numpy as np
 
-from ..errors import DimensionError, DiscreteTimeError, InputError, NonFiniteError
+from ..errors import (DimensionError, DiscreteTimeError, InputError, NonFiniteError,
+                      ParameterError)
 
-__all__ = ["as_finite_array", "as_statespace", "require_continuous", "require_finite_system"]
+__all__ = ["as_finite_array", "as_statespace", "positive_scalar", "require_continuous",
+           "require_finite_system"]
 
 
 def as_finite_array(value, name: str, *, ndim: int | None = None, dtype=float) -> np.ndarray:
@@ -83,3 +85,21 @@ def as_statespace(sys, name: str = "system") -> control.StateSpace:
     require_continuous(ss, name)
     require_finite_system(ss, name)
     return ss
+
+
+def positive_scalar(value, name: str) -> float:
+    """``value`` as a positive finite float, or a typed error naming ``name``.
+
+    Examples
+    --------
+    >>> positive_scalar(2, "dt")
+    2.0
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ParameterError(f"{name} must be a real number, got {value!r}")
+    value = float(value)
+    if not np.isfinite(value):
+        raise NonFiniteError(f"{name} must be finite, got {value!r}")
+    if value <= 0:
+        raise ParameterError(f"{name} must be positive, got {value!r}")
+    return value

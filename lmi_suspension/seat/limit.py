@@ -30,7 +30,8 @@ from dataclasses import dataclass, field
 import cvxpy as cp
 import numpy as np
 
-from ..errors import InfeasibleError, NonFiniteError, ParameterError, SolverError
+from ..errors import InfeasibleError, ParameterError, SolverError
+from ..lti.checks import positive_scalar
 from .model import seat_matrices
 from .params import SeatParameters
 from .roads import RoadInput
@@ -141,13 +142,13 @@ def bump_limit(road: RoadInput, params: SeatParameters | None = None, *,
     p = SeatParameters() if params is None else params
     if not isinstance(p, SeatParameters):
         raise ParameterError(f"params must be a SeatParameters, got {type(p).__name__}")
-    u_max = p.u_max if u_max is None else _positive(u_max, "u_max")
-    z_max = p.z_max if z_max is None else _positive(z_max, "z_max")
-    dt = _positive(dt, "dt")
+    u_max = p.u_max if u_max is None else positive_scalar(u_max, "u_max")
+    z_max = p.z_max if z_max is None else positive_scalar(z_max, "z_max")
+    dt = positive_scalar(dt, "dt")
     if isinstance(refine, bool) or not isinstance(refine, (int, np.integer)) or refine < 1:
         raise ParameterError(f"refine must be a positive integer, got {refine!r}")
     if terminal_tol is not None:
-        terminal_tol = _positive(terminal_tol, "terminal_tol")
+        terminal_tol = positive_scalar(terminal_tol, "terminal_tol")
 
     t0, t1 = float(road.t[0]), float(road.t[-1])
     N = int(math.floor((t1 - t0) / dt + 1e-9))
@@ -211,12 +212,3 @@ def bump_limit(road: RoadInput, params: SeatParameters | None = None, *,
         simulation=fine)
 
 
-def _positive(value, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)):
-        raise ParameterError(f"{name} must be a real number, got {value!r}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise NonFiniteError(f"{name} must be finite, got {value!r}")
-    if value <= 0:
-        raise ParameterError(f"{name} must be positive, got {value!r}")
-    return value

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 
-from ..errors import DimensionError, NonFiniteError, ParameterError
-from ..lti.checks import as_finite_array
+from ..errors import DimensionError, ParameterError
+from ..lti.checks import as_finite_array, positive_scalar
 
 __all__ = ["RoadInput", "bump", "white_noise", "iso8608_road", "ISO8608_GD_N0",
            "ISO8608_N0", "ISO8608_BAND", "iso8608_psd"]
@@ -86,20 +86,9 @@ class RoadInput:
         return float(self.t[-1])
 
 
-def _positive(value, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise ParameterError(f"{name} must be a real number, got {value!r}")
-    value = float(value)
-    if not math.isfinite(value):
-        raise NonFiniteError(f"{name} must be finite, got {value!r}")
-    if value <= 0:
-        raise ParameterError(f"{name} must be positive, got {value!r}")
-    return value
-
-
 def _time_grid(t_end: float, dt: float) -> np.ndarray:
-    t_end = _positive(t_end, "t_end")
-    dt = _positive(dt, "dt")
+    t_end = positive_scalar(t_end, "t_end")
+    dt = positive_scalar(dt, "dt")
     if dt > t_end:
         raise ParameterError(f"dt ({dt} s) must not exceed t_end ({t_end} s)")
     n = int(round(t_end / dt))
@@ -147,9 +136,9 @@ def bump(a: float = 0.1, l: float = 2.0, V0_kmh: float = 30.0, *, t_end: float =
     >>> round(float(r.z0.max()), 6), round(float(r.t[r.z0.argmax()]), 3)
     (0.1, 0.12)
     """
-    a = _positive(a, "a")
-    l = _positive(l, "l")
-    V0 = _positive(V0_kmh, "V0_kmh") / 3.6
+    a = positive_scalar(a, "a")
+    l = positive_scalar(l, "l")
+    V0 = positive_scalar(V0_kmh, "V0_kmh") / 3.6
     t = _time_grid(t_end, dt)
     duration = l / V0
     on = t <= duration
@@ -192,13 +181,13 @@ def white_noise(t_end: float, dt: float, *, psd: float = 1.0, bandwidth_hz: floa
     True
     """
     rng = _require_rng(rng)
-    psd = _positive(psd, "psd")
+    psd = positive_scalar(psd, "psd")
     t = _time_grid(t_end, dt)
     dt = float(t[1] - t[0])
     nyquist = 0.5 / dt
     w = rng.standard_normal(t.size) * math.sqrt(psd / dt)
     if bandwidth_hz is not None:
-        bandwidth_hz = _positive(bandwidth_hz, "bandwidth_hz")
+        bandwidth_hz = positive_scalar(bandwidth_hz, "bandwidth_hz")
         if bandwidth_hz > nyquist * (1 + 1e-12):
             raise ParameterError(
                 f"bandwidth_hz ({bandwidth_hz}) exceeds the Nyquist frequency {nyquist} Hz")
@@ -284,8 +273,8 @@ def iso8608_road(road_class: str, V_kmh: float, t_end: float, dt: float, *,
     """
     rng = _require_rng(rng)
     key = _road_class(road_class)
-    V = _positive(V_kmh, "V_kmh") / 3.6
-    n_lo, n_hi = (_positive(b, "band edge") for b in band)
+    V = positive_scalar(V_kmh, "V_kmh") / 3.6
+    n_lo, n_hi = (positive_scalar(b, "band edge") for b in band)
     if n_hi <= n_lo:
         raise ParameterError(f"band must be increasing, got {band!r}")
     t = _time_grid(t_end, dt)
