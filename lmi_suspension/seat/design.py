@@ -32,7 +32,7 @@ from ..mu import MusynOptions, MusynResult, musyn
 from .augmented import SeatAugmentedPlant, SeatDesignOptions, seat_augmented_plant
 from .params import SeatParameters
 
-__all__ = ["DEFAULT_DESIGN", "DEFAULT_MUSYN", "DEFAULT_OMEGA", "SeatMuDesign",
+__all__ = ["DEFAULT_DESIGN", "ROBUST_DESIGN", "DEFAULT_MUSYN", "DEFAULT_OMEGA", "SeatMuDesign",
            "design_mu_controller", "design_nominal_hinf"]
 
 logger = logging.getLogger(__name__)
@@ -60,6 +60,13 @@ DEFAULT_DESIGN = SeatDesignOptions(
     include_paper=False,
     parametric_complex=True,
 )
+
+#: A variant that certifies robust performance (µ < 1) for its weights: a smaller design
+#: disturbance (0.3 m/s per unit w, shaped below 3 rad/s) and a looser comfort weight.
+#: Measured 2026-11-22: µ = 0.752 (upper = lower) over the delay cover 0–25 ms; bump peak
+#: z̈3 ≈ 11.7 / 12.9 / 15.5 m/s² at 0 / 10 / 25 ms, i.e. above half passive at 25 ms —
+#: the trade-off against DEFAULT_DESIGN (µ ≈ 1.6, ≤ half passive at every delay).
+ROBUST_DESIGN = replace(DEFAULT_DESIGN, acc_ref=6.0, w_scale=0.3, w_corner=3.0)
 
 #: D-K settings: each K-step runs the LMI and the (balanced) Riccati route and keeps the
 #: lower certified γ; constant D-scales (order-2 fits did not lower µ and double the
