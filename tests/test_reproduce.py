@@ -4,7 +4,6 @@ The µ design itself is replaced by a fast stand-in (a fixed first-order control
 two-record D-K history) so that these tests check the pipeline, not the synthesis.
 """
 
-import dataclasses
 import importlib
 import json
 import math
@@ -18,6 +17,7 @@ from matplotlib.image import imread
 from lmi_suspension.errors import AssumptionError, ParameterError
 from lmi_suspension.io import load_controller
 from lmi_suspension.mu.dk import MusynIteration
+from lmi_suspension.seat.design import SeatMuDesign
 from lmi_suspension.seat import (
     SeatDesignOptions,
     bump,
@@ -33,19 +33,6 @@ EXPECTED_PNGS = {
     "fig11_bump_u_applied.png", "fig12_noise_z3dd.png", "fig13_noise_x1.png",
     "fig14_noise_u_applied.png", "fig15_mu_bounds.png", "peak_vs_delay.png", "iso_C_z3dd.png",
 }
-
-
-@dataclasses.dataclass(frozen=True)
-class _Design:
-    K: object
-    aug: object
-    musyn: object
-    mu_peak: float
-    mu_lower_peak: float
-    omega: np.ndarray
-    mu_upper: np.ndarray
-    mu_lower: np.ndarray
-    seconds: float
 
 
 def _stand_in(fail_riccati=False):
@@ -66,7 +53,7 @@ def _stand_in(fail_riccati=False):
         for rec in history:
             if callback is not None:
                 callback(rec)
-        return _Design(K=K_mu, aug=SimpleNamespace(options=SeatDesignOptions()),
+        return SeatMuDesign(K=K_mu, aug=SimpleNamespace(options=SeatDesignOptions()),
                        musyn=SimpleNamespace(history=history), mu_peak=float(upper.max()),
                        mu_lower_peak=float(0.9 * upper.max()), omega=omega, mu_upper=upper,
                        mu_lower=0.9 * upper, seconds=0.0)

@@ -224,10 +224,12 @@ def _freqresp(sys: control.StateSpace, omega: np.ndarray) -> np.ndarray:
     return out
 
 
-def _mu_bounds(CL, struct, omega, rng):
+def _mu_bounds(CL, struct, omega, rng, M=None):
+    """µ bounds of ``CL`` over ``omega``; pass its frequency response ``M`` if known."""
     from .bounds import mussv
 
-    return mussv(_freqresp(CL, omega), struct, omega=omega, rng=rng)
+    M = _freqresp(CL, omega) if M is None else M
+    return mussv(M, struct, omega=omega, rng=rng)
 
 
 def _scaled_peak(fits, M: np.ndarray, omega: np.ndarray, struct: BlockStructure) -> float:
@@ -333,7 +335,8 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
                 raise InfeasibleError("the first K-step did not give a stabilising controller")
             stop_reason = f"K-step at iteration {it} returned a non-stabilising controller"
             break
-        mu = _mu_bounds(CL, dk_struct, omega, rng)
+        M = _freqresp(CL, omega)  # one response for the D-step and the D-fit check
+        mu = _mu_bounds(CL, dk_struct, omega, rng, M)
         t2 = time.perf_counter()
         upper, lower = np.asarray(mu.upper), np.asarray(mu.lower)
         k_peak = int(np.argmax(upper))
@@ -357,7 +360,6 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
         if done is None:
             # Emphasise the frequencies that set the peak: the fit matters most there.
             weights = 0.2 + upper / mu_peak
-            M = _freqresp(CL, omega)
             dfit = fit_dscales(omega, mu.d_blocks, max_order=opts.max_dfit_order,
                                rtol=opts.dfit_rtol, weights=weights,
                                mu_check=lambda fits: _scaled_peak(fits, M, omega, dk_struct),

@@ -13,8 +13,9 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from ..errors import DimensionError, ParameterError
+from ..errors import DimensionError
 from ..lti.checks import as_finite_array
+from .roads import require_uniform_time
 
 __all__ = ["WK_PARAMETERS", "wk_filter", "wk_gain", "weighted_acceleration", "weighted_rms",
            "rms", "vdv", "ComfortMetrics", "comfort_metrics"]
@@ -85,13 +86,7 @@ def _signal(t, a):
     a = as_finite_array(a, "a", ndim=1)
     if t.shape != a.shape:
         raise DimensionError(f"t and a must have the same length, got {t.shape} and {a.shape}")
-    if t.size < 2:
-        raise DimensionError("need at least two samples")
-    steps = np.diff(t)
-    if np.any(steps <= 0):
-        raise ParameterError("t must be strictly increasing")
-    if np.ptp(steps) > 1e-6 * steps.mean():
-        raise ParameterError("t must be uniformly spaced")
+    require_uniform_time(t, "t")
     return t, a
 
 

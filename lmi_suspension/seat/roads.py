@@ -64,13 +64,7 @@ class RoadInput:
         if not (t.shape == z0.shape == w.shape):
             raise DimensionError(
                 f"road t, z0, w must have the same length, got {t.shape}, {z0.shape}, {w.shape}")
-        if t.size < 2:
-            raise DimensionError("a road needs at least two samples")
-        steps = np.diff(t)
-        if np.any(steps <= 0):
-            raise ParameterError("road.t must be strictly increasing")
-        if np.ptp(steps) > 1e-6 * steps.mean():
-            raise ParameterError("road.t must be uniformly spaced")
+        require_uniform_time(t, "road.t")
         for name, arr in (("t", t), ("z0", z0), ("w", w)):
             arr.setflags(write=False)
             object.__setattr__(self, name, arr)
@@ -84,6 +78,18 @@ class RoadInput:
     def t_end(self) -> float:
         """Last sample time, s."""
         return float(self.t[-1])
+
+
+def require_uniform_time(t: np.ndarray, name: str = "t") -> None:
+    """Raise a typed error unless ``t`` has at least two strictly increasing, uniformly
+    spaced samples (roads and comfort metrics both assume a fixed step)."""
+    if t.size < 2:
+        raise DimensionError(f"{name} needs at least two samples")
+    steps = np.diff(t)
+    if np.any(steps <= 0):
+        raise ParameterError(f"{name} must be strictly increasing")
+    if np.ptp(steps) > 1e-6 * steps.mean():
+        raise ParameterError(f"{name} must be uniformly spaced")
 
 
 def _time_grid(t_end: float, dt: float) -> np.ndarray:
