@@ -57,6 +57,9 @@ class HinfsynOptions:
         ``method="riccati"`` only: balance the plant (as the LMI route does) before
         python-control sees it. Off by default so that the baseline is python-control
         exactly as users call it.
+    direct_solve_method : str
+        Clarabel's KKT factorisation: ``"faer"`` (supernodal, multithreaded; about twice
+        as fast as ``"qdldl"`` on the dense KKT systems of these SDPs) or ``"qdldl"``.
     """
 
     gamma: float | None = None
@@ -76,6 +79,7 @@ class HinfsynOptions:
     scale: bool = True
     cert_rtol: float = 5e-3
     riccati_scale: bool = False
+    direct_solve_method: str = "faer"
 
     def __post_init__(self):
         if self.gamma is not None and not (np.isfinite(self.gamma) and self.gamma > 0):
@@ -86,6 +90,9 @@ class HinfsynOptions:
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ParameterError(f"{name} must be positive and finite, got {v!r}")
+        if self.direct_solve_method not in ("faer", "qdldl"):
+            raise ParameterError("direct_solve_method must be 'faer' or 'qdldl', got "
+                                 f"{self.direct_solve_method!r}")
         if int(self.max_iter) < 1 or int(self.max_recoveries) < 0:
             raise ParameterError("max_iter must be >= 1 and max_recoveries >= 0")
 
@@ -95,7 +102,8 @@ class HinfsynOptions:
                     tol_feas=self.tol_feas, max_iter=int(self.max_iter),
                     reduced_tol_gap_abs=self.reduced_tol_gap_abs,
                     reduced_tol_gap_rel=self.reduced_tol_gap_rel,
-                    reduced_tol_feas=self.reduced_tol_feas)
+                    reduced_tol_feas=self.reduced_tol_feas,
+                    direct_solve_method=self.direct_solve_method)
 
 
 @dataclass(frozen=True)
