@@ -24,12 +24,10 @@ DATA = Path(__file__).parents[2] / "shared" / "data" / "compleib_subset.json"
 RELAX = HinfsynOptions().gamma_relax
 PROBLEMS = ["AC1", "AC2", "AC3", "AC4", "AC6", "HE1", "HE2", "REA1", "REA2", "DIS1",
             "NN1", "NN2"]
-# The target is 0.5 % above the LMI optimum; the well-conditioned
-# reconstruction currently needs up to 2 % (AC6 0.7 %, NN1 1.6 %, measured by this test)
-# and HE1 far more (its optimum is approached only by controllers with unbounded
-# gains).  The budget documents what is achieved; it is not the target.
-BUDGET = 0.02
-LOOSE = {"HE1": 1.0}
+# Certified γ within 0.5 % of the LMI optimum (the reconstruction target); measured
+# by `python benchmarks/compleib_table.py`: at most 0.27 % (AC6, HE1) with the default
+# gamma_relax = 0.3 %.
+BUDGET = 0.005
 
 
 def load(name):
@@ -48,7 +46,25 @@ def test_compleib_certified_gamma(name):
     assert np.isfinite(gamma_cl) and np.all(np.real(res.poles) < 0)
     assert res.gamma == pytest.approx(gamma_cl, rel=1e-6)
     assert res.gamma >= res.gamma_lower * (1 - 1e-2)  # lower bound up to solver accuracy
-    assert res.gamma <= res.gamma_lower * (1 + LOOSE.get(name, BUDGET))
+    if name == "AC4":
+        # the γ minimisation stops above the infimum here (it is approached only by
+        # unbounded X, Y): the best known value is python-control's Riccati controller,
+        # certified in test_compleib_ac4_against_riccati
+        return
+    assert res.gamma <= res.gamma_lower * (1 + BUDGET)
+
+
+def test_compleib_ac4_against_riccati():
+    # AC4 is regular (D12, D21 full rank), so python-control's Riccati hinfsyn applies;
+    # its controller, certified here by hinfnorm(lft(P, K)), is the best known value
+    # (0.55729 on this machine). The LMI route's certified γ stays within 1 % of it
+    # (measured 0.53 %) although its own optimum (0.5650) is above it.
+    P = load("AC4")
+    K, _CL, _gam, _ = control.hinfsyn(P.sys, P.ny, P.nu)
+    best = hinfnorm(lft(P, K))[0]
+    res = hinfsyn(P, P.ny, P.nu)
+    assert np.all(np.real(res.poles) < 0)
+    assert best <= res.gamma <= best * 1.01
 
 
 def test_compleib_ac1_infimum_is_zero():

@@ -137,9 +137,9 @@ def test_property_lmi_not_worse_than_riccati(seed):
     ric = hinfsyn(P, ny, nu, method="riccati")
     gamma_cl = hinfnorm(lft(P, lmi.K))[0]
     assert lmi.gamma == pytest.approx(gamma_cl, rel=1e-6)
-    # target 0.5 %; measured up to 0.6 % on these seeds (reconstruction budget, see
-    # tests/test_compleib.py)
-    assert lmi.gamma <= ric.gamma * 1.01
+    # the bound: never more than 0.5 % above the certified Riccati γ (an
+    # unstable Riccati controller certifies as inf)
+    assert lmi.gamma <= ric.gamma * 1.005
     # the LMI optimum is a lower bound for every controller, Riccati's included
     assert lmi.gamma_lower <= ric.gamma * (1 + 1e-4)
 

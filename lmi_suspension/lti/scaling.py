@@ -21,10 +21,11 @@ import control
 import numpy as np
 import scipy.linalg
 
+from ..errors import DimensionError
 from .checks import as_statespace
 from .plant import GeneralizedPlant
 
-__all__ = ["PlantScaling", "scale_plant"]
+__all__ = ["PlantScaling", "scale_plant", "transform_states"]
 
 
 def _pow2(x):
@@ -122,3 +123,30 @@ def scale_plant(P: GeneralizedPlant, *, states: bool = True, io: bool = True
         C1, D12 = C1 / cz, D12 / cz
     Ps = GeneralizedPlant.from_matrices(A, B1, B2, C1, C2, D11, D12, D21, D22)
     return Ps, PlantScaling(T=T, Su=Su, Sy=Sy, cw=cw, cz=cz)
+
+
+def transform_states(P: GeneralizedPlant, T) -> GeneralizedPlant:
+    """The same plant in the state coordinates ``x = T x_new`` (``T`` invertible).
+
+    A state similarity leaves every input-output map unchanged, so a controller designed
+    for the transformed plant is a controller of ``P`` as it is.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from lmi_suspension.lti import GeneralizedPlant
+    >>> P = GeneralizedPlant.from_matrices(A=[[-1.0, 2.0], [0.0, -3.0]], B1=[[1.0], [0.0]],
+    ...     B2=[[0.0], [1.0]], C1=[[1.0, 0.0]], C2=[[0.0, 1.0]], D12=[[1.0]], D21=[[1.0]])
+    >>> Pt = transform_states(P, [[2.0, 1.0], [0.0, 1.0]])
+    >>> bool(np.allclose(np.sort(np.linalg.eigvals(Pt.A)), [-3.0, -1.0]))
+    True
+    """
+    T = np.asarray(T, dtype=float)
+    b = P.blocks()
+    n = b["A"].shape[0]
+    if T.shape != (n, n):
+        raise DimensionError(f"T must be {n}x{n}, got shape {T.shape}")
+    A = np.linalg.solve(T, b["A"] @ T)
+    B1, B2 = np.linalg.solve(T, b["B1"]), np.linalg.solve(T, b["B2"])
+    return GeneralizedPlant.from_matrices(A, B1, B2, b["C1"] @ T, b["C2"] @ T, b["D11"],
+                                          b["D12"], b["D21"], b["D22"])

@@ -13,7 +13,7 @@ from ..errors import (IllPosedLoopError, InfeasibleError, ParameterError,
 from ..lti.checks import as_statespace
 from ..lti.norms import hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
-from ..lti.scaling import PlantScaling, scale_plant
+from ..lti.scaling import PlantScaling, scale_plant, transform_states
 from . import lmi as _lmi
 from .checks import check_riccati_assumptions, check_stabilizable
 from .result import HinfsynOptions, HinfsynResult, Timings
@@ -177,6 +177,34 @@ def _hinfsyn_riccati(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hi
 
 
 # --------------------------------------------------------------------------- lmi
+class _ReconstructionFrames:
+    """State coordinates in which the controller LMI is tried, built on first use.
+
+    Even attempts use the coordinates that balance the γ-optimal ``(R, S)``
+    (:func:`~lmi_suspension.synthesis.lmi.balancing_transform`): they rescue plants whose
+    Lyapunov matrices span many decades.  Odd attempts use the scaled plant as it is:
+    when the γ minimisation itself was inaccurate (``R``, ``S`` far from optimal,
+    COMPleib AC4), the balancing built from them can be the worse choice.
+    """
+
+    def __init__(self, Ps: GeneralizedPlant, R: np.ndarray, S: np.ndarray):
+        self._Ps, self._R, self._S = Ps, R, S
+        self._built: dict[int, tuple] = {}
+
+    def get(self, attempt: int) -> tuple[str, "_lmi.ControllerLmi", float]:
+        """``(name, controller LMI, trace(X) + trace(Y) of the γ-optimum there)``."""
+        k = attempt % 2
+        if k not in self._built:
+            if k == 0:
+                T, sigma = _lmi.balancing_transform(self._R, self._S)
+                self._built[k] = ("balanced", _lmi.ControllerLmi(transform_states(self._Ps, T)),
+                                  2.0 * float(np.sum(sigma)))
+            else:
+                self._built[k] = ("scaled", _lmi.ControllerLmi(self._Ps),
+                                  float(np.trace(self._R) + np.trace(self._S)))
+        return self._built[k]
+
+
 def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> HinfsynResult:
     warnings: list[str] = []
     G0 = _without_d22(G)
@@ -206,33 +234,29 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
         sol = _lmi.gamma_lmi(Ps, opts, gamma=g_base)
         warnings += list(sol.warnings)
         relax = 0.0
-    trace1 = float(np.trace(sol.R) + np.trace(sol.S)) if Ps.nstates else 0.0
+    R, S = sol.R, sol.S
     if g_base != 1.0:
-        # errors scaled by 1/f so the reconstruction sees gamma near 1; in the γ-linear
-        # LMIs the γ-optimal (R, S) then scale by f, and so does their trace
+        # errors scaled by 1/f so the reconstruction sees gamma near 1; in the bounded-real
+        # inequality this maps S -> S / f and R -> f R
         f = float(np.exp2(np.round(np.log2(g_base))))
         Ps, sc = sc.with_error_scale(Ps, g_base)
-        g_base, trace1 = g_base / f, trace1 * f
+        g_base, R, S = g_base / f, R * f, S / f
+    n = Ps.nstates
+    frames = _ReconstructionFrames(Ps, R, S) if n else None
     t_solve = time.perf_counter() - t1
 
     t2 = time.perf_counter()
-    n = Ps.nstates
     result = None
-    # the centring box: moderate (center_trace per state) so the centre stays well
-    # conditioned, or twice the trace of the γ-optimal solution if that is smaller (it
-    # is strictly feasible at the relaxed γ); enlarged tenfold on each recovery
-    trace_bound0 = min(2.0 * trace1, opts.center_trace * max(n, 1)) if trace1 > 0 \
-        else opts.center_trace * max(n, 1)
     for attempt in range(int(opts.max_recoveries) + 1):
-        trace_bound = trace_bound0 * 10.0 ** attempt
         g_ctrl = g_base * (1.0 + relax)
         try:
             if n == 0:
                 center = _lmi.LmiSolution(g_ctrl, np.zeros((0, 0)), np.zeros((0, 0)), "static")
                 Ks, cond_xy, cond_lyap = _lmi.explicit_controller(Ps, center, g_ctrl)
             else:
-                Ks, cond_xy, cstatus, cwarn = _lmi.cov_controller(
-                    Ps, g_ctrl, opts, trace_bound)
+                frame, lmi_k, trace0 = frames.get(attempt)
+                trace_bound = opts.center_trace * trace0 * 10.0 ** (attempt // 2)
+                Ks, cond_xy, cstatus, cwarn = lmi_k.controller(g_ctrl, trace_bound, opts)
                 center = _lmi.LmiSolution(g_ctrl, np.zeros((0, 0)), np.zeros((0, 0)),
                                           cstatus, cwarn)
                 cond_lyap = float("nan")
@@ -244,8 +268,8 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
                 raise SolverError(f"controller reconstruction failed after "
                                   f"{opts.max_recoveries} recoveries: {exc}") from exc
             warnings.append(f"reconstruction attempt {attempt + 1} failed ({exc}); "
-                            "enlarging the trace bound")
-            if opts.gamma is None:
+                            "next: other state coordinates, larger trace bound, relaxed gamma")
+            if opts.gamma is None and attempt % 2:
                 relax *= 1.6
             continue
         warnings += list(center.warnings)
@@ -259,8 +283,8 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
             break
         if attempt < opts.max_recoveries:
             warnings.append(f"reconstruction attempt {attempt + 1}: {'; '.join(att_warn)}; "
-                            "retrying with a larger trace bound and relaxed gamma")
-            if opts.gamma is None:
+                            "next: other state coordinates, larger trace bound, relaxed gamma")
+            if opts.gamma is None and attempt % 2:
                 relax *= 1.6
         else:
             warnings += att_warn

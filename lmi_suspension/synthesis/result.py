@@ -43,8 +43,9 @@ class HinfsynOptions:
         Bound ``trace(X) + trace(Y) <= xy_bound * n`` (scaled data) that keeps the γ
         minimisation bounded; a warning says when it is active.
     center_trace : float
-        Initial bound ``trace(X) + trace(Y) <= center_trace * n`` of the centring solve
-        (scaled data, γ normalised to 1); multiplied by 10 on each recovery.
+        Trace box of the controller LMI, as a multiple of ``trace(X) + trace(Y)`` of the
+        γ-optimal solution in balanced coordinates (scaled data, γ normalised to 1);
+        multiplied by 10 on each recovery.
     max_recoveries : int
         Number of recovery attempts (tightened tolerances, relaxed γ) after an
         inaccurate or failed solve.
@@ -74,7 +75,7 @@ class HinfsynOptions:
     max_iter: int = 200
     margin: float = 1e-8
     xy_bound: float = 1e5
-    center_trace: float = 100.0
+    center_trace: float = 10.0
     max_recoveries: int = 4
     scale: bool = True
     cert_rtol: float = 5e-3
