@@ -58,6 +58,13 @@ class HinfsynOptions:
         ``method="riccati"`` only: balance the plant (as the LMI route does) before
         python-control sees it. Off by default so that the baseline is python-control
         exactly as users call it.
+    polish_steps : int
+        When the reconstructed controller certifies *below* the LMI optimum (the γ
+        minimisation stopped early), up to this many re-solves of the controller LMI at a
+        level below the best certified one; each is kept only if its controller
+        certifies lower.
+    polish_step : float
+        Relative step of the first polish probe, halved after each probe that fails.
     direct_solve_method : str
         Clarabel's KKT factorisation: ``"faer"`` (supernodal, multithreaded; about twice
         as fast as ``"qdldl"`` on the dense KKT systems of these SDPs) or ``"qdldl"``.
@@ -80,12 +87,14 @@ class HinfsynOptions:
     scale: bool = True
     cert_rtol: float = 5e-3
     riccati_scale: bool = False
+    polish_steps: int = 4
+    polish_step: float = 0.01
     direct_solve_method: str = "faer"
 
     def __post_init__(self):
         if self.gamma is not None and not (np.isfinite(self.gamma) and self.gamma > 0):
             raise ParameterError(f"gamma must be positive and finite, got {self.gamma!r}")
-        for name in ("gamma_relax", "gamma_atol", "tol_gap_abs", "tol_gap_rel", "tol_feas", "margin",
+        for name in ("polish_step", "gamma_relax", "gamma_atol", "tol_gap_abs", "tol_gap_rel", "tol_feas", "margin",
                      "xy_bound", "center_trace", "cert_rtol", "reduced_tol_gap_abs",
                      "reduced_tol_gap_rel", "reduced_tol_feas"):
             v = getattr(self, name)
@@ -94,6 +103,8 @@ class HinfsynOptions:
         if self.direct_solve_method not in ("faer", "qdldl"):
             raise ParameterError("direct_solve_method must be 'faer' or 'qdldl', got "
                                  f"{self.direct_solve_method!r}")
+        if not self.polish_step < 1 or int(self.polish_steps) < 0:
+            raise ParameterError("polish_step must be in (0, 1) and polish_steps >= 0")
         if int(self.max_iter) < 1 or int(self.max_recoveries) < 0:
             raise ParameterError("max_iter must be >= 1 and max_recoveries >= 0")
 
