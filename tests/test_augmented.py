@@ -158,6 +158,27 @@ def test_parametric_channels_reproduce_the_occupant_range(full):
         assert closed[3, 3] == pytest.approx(G[3, 1] * Npade, rel=1e-9)
 
 
+def test_shaped_disturbance_column():
+    # w -> [e_acc, e_defl, y1]: the seat's ż0 column times w_scale · s/(s + ω_c) ·
+    # ω_r²/(s² + √2 ω_r s + ω_r²), written out here (nominal plant, no uncertainty).
+    o = SeatDesignOptions(include_delay=False, include_parametric=False, include_paper=False,
+                          w_scale=0.4, w_corner=13.5, w_rolloff=50.0)
+    aug = seat_augmented_plant(o)
+    iw = aug.P.input_labels.index("w")
+    p = aug.params
+    for w in (0.5, 13.5, 50.0, 400.0):
+        s = 1j * w
+        Wd = 0.4 * s / (s + 13.5) * 50.0 ** 2 / (s ** 2 + np.sqrt(2) * 50.0 * s + 50.0 ** 2)
+        G = seat_model(p)(s)
+        Wk = complex(wk_weight(o.wk_order, acc_ref=o.acc_ref)(s))
+        col = aug.P(s)[:, iw]
+        np.testing.assert_allclose(col[[0, 2, 3]], [Wk * G[0, 0] * Wd, G[1, 0] * Wd / p.z_max,
+                                                    G[3, 0] * Wd], rtol=1e-9)
+    # A second-order Butterworth low pass is 1/√2 at its corner.
+    lo = seat_augmented_plant(o).P(1j * 50.0)[3, iw] / seat_model(p)(1j * 50.0)[3, 0]
+    assert abs(lo) == pytest.approx(0.4 * 50 / abs(50j + 13.5) / np.sqrt(2), rel=1e-9)
+
+
 def test_options_select_the_blocks():
     none = seat_augmented_plant(SeatDesignOptions(include_delay=False, include_parametric=False,
                                                   include_paper=False))
@@ -179,6 +200,8 @@ def test_options_select_the_blocks():
     (dict(u_max=0.0), ParameterError),
     (dict(z_max=float("nan")), NonFiniteError),
     (dict(w_scale=float("inf")), NonFiniteError),
+    (dict(w_rolloff=0.0), ParameterError),
+    (dict(w_corner=-1.0), ParameterError),
     (dict(delay_min=0.03, delay_max=0.02), ParameterError),
     (dict(delay_min=-0.01), ParameterError),
     (dict(force_rolloff_ratio=0.5), ParameterError),

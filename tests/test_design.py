@@ -12,9 +12,10 @@ import control
 import numpy as np
 import pytest
 
-from lmi_suspension.seat import bump, closed_loop_stable, seat_model, simulate
-from lmi_suspension.seat.design import (DEFAULT_DESIGN, ROBUST_DESIGN, SeatMuDesign,
-                                        design_mu_controller, design_nominal_hinf)
+from lmi_suspension.seat import (bump, closed_loop_stable, seat_model, simulate,
+                                 stability_delay_margin)
+from lmi_suspension.seat.design import (DEFAULT_DESIGN, SeatMuDesign, design_mu_controller,
+                                        design_nominal_hinf)
 
 pytestmark = pytest.mark.slow
 
@@ -52,12 +53,25 @@ def test_mu_bounds_consistent(design):
     assert design.mu_lower_peak <= design.mu_peak * (1 + 1e-6)
     assert np.all(design.mu_lower <= design.mu_upper * (1 + 1e-6))
     assert design.mu_peak == pytest.approx(float(np.max(design.mu_upper)))
-    # Target µ < 1 is NOT reached (measured 2026-11-22: upper 3.524, lower 3.524 at the
-    # body mode; design.py docstring explains the complex m3 cover). The lower bound is a
-    # perturbation that attains it, so µ > 1 is a fact for this controller; assert the
-    # measured level so that both a regression and a fix show up.
-    assert 1.0 < design.mu_lower_peak
-    assert design.mu_peak < 4.0
+
+
+def test_mu_certified_below_one(design):
+    """Issue 6 target: robust performance, µ upper bound < 1 on the dense grid, over the
+    synthesised structure (delay cover 0–25 ms + performance block). Measured 2026-11-23:
+    0.940. The bound is recomputed here from the controller alone (lft + mussv on a grid
+    of 200 points, a route independent of musyn's D-K bookkeeping), and the dense grid
+    must reach well beyond the delay's corner (1/25 ms = 40 rad/s) on both sides."""
+    from lmi_suspension import lft, mussv
+
+    assert design.mu_peak < 1.0
+    assert design.omega.min() <= 0.1 and design.omega.max() >= 3000.0
+    omega = np.logspace(-1, 3.5, 200)
+    M = lft(design.aug.P, design.musyn.K, design.aug.nmeas, design.aug.ncon)(1j * omega)
+    again = mussv(M, design.aug.blk, omega=omega, rng=np.random.default_rng(1))
+    assert np.max(again.upper) < 1.0
+    assert np.max(again.lower) <= np.max(again.upper) * (1 + 1e-6)
+    # The design grid's peak is not a grid artefact: both grids agree to 2 %.
+    assert np.max(again.upper) == pytest.approx(design.mu_peak, rel=0.02)
 
 
 def _pade_loop_poles(K, delay, order=8):
@@ -78,6 +92,16 @@ def test_closed_loop_stable_two_routes(design, delay):
     assert np.max(_pade_loop_poles(design.K, delay).real) < 0
 
 
+def test_delay_margin_beyond_the_interval(design):
+    """Stability is kept on the whole interval 0–25 ms and lost at the reported margin
+    (measured 2026-11-23: ≈ 0.24 s): the margin (crossing analysis) is checked by the
+    Nyquist count just below and just above it, an independent route."""
+    margin = stability_delay_margin(design.K)
+    assert 0.025 < margin < 1.0
+    assert closed_loop_stable(design.K, 0.98 * margin)
+    assert not closed_loop_stable(design.K, 1.02 * margin)
+
+
 @pytest.mark.parametrize("delay", [0.0, 0.025])
 def test_bump_limits(bump_runs, delay):
     m = bump_runs[delay]
@@ -95,21 +119,8 @@ def test_nominal_controller_names():
 @pytest.mark.parametrize("delay", [0.0, 0.025])
 def test_bump_comfort_half_of_passive(bump_runs, delay):
     """Issue 6 target: peak z̈3 on the bump at most half the passive peak (measured
-    2026-11-22: 8.7 m/s² at 0 ms, 12.7 m/s² at 25 ms; passive 26.47 from an independent
+    2026-11-23: 9.35 m/s² at 0 ms, 12.85 m/s² at 25 ms; passive 26.47 from an independent
     simulate(None, bump()) in this test)."""
     passive = simulate(None, bump()).metrics().peak_z3dd
     assert passive == pytest.approx(PASSIVE_PEAK, abs=0.01)
     assert bump_runs[delay].peak_z3dd <= passive / 2
-
-
-def test_robust_preset_certifies_mu_below_one():
-    """ROBUST_DESIGN: certified µ < 1 over the 0–25 ms delay cover (measured 0.752). The
-    certificate is checked here by a route that did not produce it: the µ lower bound (a
-    destabilising perturbation) must not exceed the upper bound, and the exact-delay
-    closed loop must be stable at the interval's ends (Nyquist and Padé-12 poles)."""
-    robust = design_mu_controller(ROBUST_DESIGN, rng=np.random.default_rng(0))
-    assert robust.mu_peak < 1.0
-    assert np.all(robust.mu_lower <= robust.mu_upper * (1 + 1e-9))
-    for delay in (0.0, 0.025):
-        assert closed_loop_stable(robust.K, delay)
-        assert np.max(_pade_loop_poles(robust.K, delay).real) < 0

@@ -126,7 +126,7 @@ def plot_peak_vs_delay(delays: Sequence[float], peaks: Mapping[str, Sequence[flo
         The passive seat's peak.
     """
     d_ms = 1e3 * np.asarray(delays, dtype=float)
-    fig = Figure(figsize=(7, 3.8), layout="constrained")
+    fig = Figure(figsize=(9, 3.8), layout="constrained")
     ax = fig.subplots()
     for label, values in peaks.items():
         ax.plot(d_ms, values, "o-", label=label)
@@ -140,6 +140,7 @@ def plot_peak_vs_delay(delays: Sequence[float], peaks: Mapping[str, Sequence[flo
     ax.set_ylabel("peak $|\\ddot z_3|$ on the bump [m/s²]")
     ax.set_ylim(bottom=0)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8)
+    # Outside the axes: seven entries inside would hide the curves of the worst controller.
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax.set_title(title)
     return fig

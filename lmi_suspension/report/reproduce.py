@@ -57,7 +57,7 @@ class _Settings:
     mc_n: int
 
 
-_FULL = _Settings(bump_t_end=3.0, noise_t_end=5.0, iso_t_end=4.0, road_dt=1e-3, sim_dt=2e-4,
+_FULL = _Settings(bump_t_end=3.0, noise_t_end=3.0, iso_t_end=3.0, road_dt=1e-3, sim_dt=2e-4,
                   limit_dt=2e-3, mc_n=8)
 _QUICK = _Settings(bump_t_end=1.5, noise_t_end=1.0, iso_t_end=1.0, road_dt=1e-3, sim_dt=5e-4,
                    limit_dt=5e-3, mc_n=2)

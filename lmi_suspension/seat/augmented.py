@@ -34,7 +34,7 @@ from .uncertainty import (DelayUncertainty, delay_uncertainty, paper_norm_bounde
 from .weights import wk_weight
 
 __all__ = ["SeatDesignOptions", "SeatAugmentedPlant", "seat_augmented_plant",
-           "BUMP_PEAK_VELOCITY"]
+           "disturbance_weight", "BUMP_PEAK_VELOCITY"]
 
 logger = logging.getLogger(__name__)
 
@@ -70,6 +70,12 @@ class SeatDesignOptions:
         If set (rad/s), the floor velocity is shaped ``w_scale s/(s + w_corner)``: below
         the corner a unit ``w`` means a floor *displacement* of ``w_scale/w_corner``
         (e.g. the bump height) instead of an ever larger stroke.
+    w_rolloff : float or None
+        If set (rad/s), the floor velocity is also low-passed by a second-order
+        Butterworth filter ``ω_r²/(s² + √2 ω_r s + ω_r²)``: the bump's velocity spectrum
+        ``|Ẑ0(jω)|`` (eq. 32) collapses above its main lobe (≈ 45 rad/s), so a design
+        disturbance that stays flat there asks for performance where the bump has no energy
+        and where the 25 ms delay makes control impossible.
     noise : tuple of float
         Sensor-noise scales on ``y = [x1, x3]``, m.
     include_delay, include_parametric, include_paper : bool
@@ -107,6 +113,7 @@ class SeatDesignOptions:
     z_max: float | None = None
     w_scale: float = BUMP_PEAK_VELOCITY
     w_corner: float | None = None
+    w_rolloff: float | None = None
     noise: tuple[float, float] = (5e-4, 5e-4)
     include_delay: bool = True
     include_parametric: bool = True
@@ -139,7 +146,7 @@ class SeatDesignOptions:
 
         for name in ("acc_ref", "force_rolloff_corner", "w_scale"):
             num(name, getattr(self, name))
-        for name in ("u_max", "z_max"):
+        for name in ("u_max", "z_max", "w_corner", "w_rolloff"):
             num(name, getattr(self, name), allow_none=True)
         for name in ("delay_min", "delay_max"):
             num(name, getattr(self, name), positive=False, allow_none=True)
@@ -229,6 +236,36 @@ class SeatAugmentedPlant:
     def __iter__(self):
         # Unpack like python-control's (P, nmeas, ncon) triple plus the structure.
         return iter((self.P, self.nmeas, self.ncon, self.blk))
+
+
+def disturbance_weight(options: SeatDesignOptions) -> control.TransferFunction:
+    """Floor velocity ż0 (m/s) per unit normalised ``w``: the design disturbance model.
+
+    ``w_scale``, times ``s/(s + w_corner)`` if ``w_corner`` is set, times the second-order
+    Butterworth low pass ``ω_r²/(s² + √2 ω_r s + ω_r²)`` if ``w_rolloff`` is set.
+
+    Parameters
+    ----------
+    options : SeatDesignOptions
+
+    Returns
+    -------
+    control.TransferFunction
+
+    Examples
+    --------
+    >>> from lmi_suspension.seat.augmented import SeatDesignOptions, disturbance_weight
+    >>> W = disturbance_weight(SeatDesignOptions(w_scale=0.5))
+    >>> float(abs(W(1j)))
+    0.5
+    """
+    W = control.tf([options.w_scale], [1.0])
+    if options.w_corner is not None:
+        W = W * control.tf([1.0, 0.0], [1.0, options.w_corner])
+    if options.w_rolloff is not None:
+        wr = options.w_rolloff
+        W = W * control.tf([wr ** 2], [1.0, math.sqrt(2.0) * wr, wr ** 2])
+    return W
 
 
 def _static(gain, inp, out, name):
@@ -359,9 +396,8 @@ def seat_augmented_plant(options: SeatDesignOptions | None = None,
     core, nominal, names, rows, p_par, q_par, p_nb, q_nb = _core(params, opts)
 
     systems = [core,
-               (_static(opts.w_scale, ["w"], ["zdot0"], "w_scale") if opts.w_corner is None
-                else control.ss(control.tf([opts.w_scale, 0.0], [1.0, opts.w_corner]),
-                                inputs=["w"], outputs=["zdot0"], name="w_scale")),
+               control.ss(disturbance_weight(opts), inputs=["w"], outputs=["zdot0"],
+                          name="w_scale"),
                control.ss(wk_weight(opts.wk_order, acc_ref=opts.acc_ref),
                           inputs=["z3dd"], outputs=["e_acc"], name="W_acc"),
                _static(1.0 / z_max, ["x1"], ["e_defl"], "W_defl"),
