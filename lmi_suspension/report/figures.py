@@ -111,6 +111,7 @@ def plot_mu_bounds(omega: np.ndarray, upper: np.ndarray, lower: np.ndarray, *,
 
 def plot_peak_vs_delay(delays: Sequence[float], peaks: Mapping[str, Sequence[float]], *,
                        limit: float | None = None, passive: float | None = None,
+                       stable: Mapping[str, Sequence[bool]] | None = None,
                        title: str = "") -> Figure:
     """Peak |z̈3| on the bump against the actuator delay, with the physical limit.
 
@@ -124,12 +125,23 @@ def plot_peak_vs_delay(delays: Sequence[float], peaks: Mapping[str, Sequence[flo
         The smallest peak any admissible force history reaches (the LP bound).
     passive : float, optional
         The passive seat's peak.
+    stable : mapping of label -> sequence of bool, optional
+        Whether each closed loop is stable at each delay; unstable points are crossed
+        out (their peak is only that of a finite record of a growing response).
     """
     d_ms = 1e3 * np.asarray(delays, dtype=float)
     fig = Figure(figsize=(9, 3.8), layout="constrained")
     ax = fig.subplots()
+    crossed = False
     for label, values in peaks.items():
-        ax.plot(d_ms, values, "o-", label=label)
+        line, = ax.plot(d_ms, values, "o-", label=label)
+        flags = None if stable is None else stable.get(label)
+        if flags is not None:
+            bad = ~np.asarray(flags, dtype=bool)
+            if bad.any():
+                ax.plot(d_ms[bad], np.asarray(values, dtype=float)[bad], "x", ms=12, mew=2.5,
+                        color="crimson", label=None if crossed else "closed loop unstable")
+                crossed = True
     if passive is not None:
         ax.axhline(passive, color="0.45", ls="--", label="passive")
         ax.axhline(passive / 2, color="0.45", ls=":", label="half passive")

@@ -463,8 +463,11 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
          "fig15_mu_bounds.png")
     peaks = {_LONG_NAMES[s.name]: list(s.peak_z3dd) for s in summaries
              if s.name != "passive" and not s.error}
+    stable = {_LONG_NAMES[s.name]: list(s.stable) for s in summaries
+              if s.name != "passive" and not s.error}
     passive_peak = summaries[0].peak_z3dd[0]
     save(figures.plot_peak_vs_delay(delays, peaks, limit=limit.peak, passive=passive_peak,
+                                    stable=stable,
                                     title="Bump: peak upper-body acceleration vs delay "
                                           "(exact delay, saturation)"),
          "peak_vs_delay.png")
