@@ -256,6 +256,20 @@ def test_scaled_plant_does_not_mutate_inputs():
     assert np.array_equal(P.A, A0)
 
 
+def test_scaled_plant_keeps_a_slow_stable_pole_next_to_fast_fit_poles():
+    """A slow weight pole (-1e-6 rad/s, as in the distillation problem) is stable however
+    fast the fit's poles are; a stability tolerance relative to the fastest pole (2e4
+    here) used to count it as unstable and reject the scaled plant."""
+    P = control.ss([[-1e-6]], [[1.0, 1.0]], [[1.0], [1.0]], [[0.0, 0.0], [0.0, 0.0]])
+    w = np.logspace(1, 4, 40)
+    d = np.abs(control.tf([1, 3e3], [1, 2e4])(1j * w))  # pole at 2e4 rad/s, chosen here
+    dfit = fit_dscales(w, [d], order=1)
+    PD = scaled_plant(P, 1, 1, dfit, [(1, 1)])
+    poles = control.poles(PD)  # python-control's eigenvalues, not the module's test
+    assert np.all(poles.real < 0)
+    assert np.min(np.abs(poles)) == pytest.approx(1e-6, rel=1e-6)
+
+
 def test_fitted_scalings_certify_mu_of_zero_diagonal_system():
     """End-to-end: pointwise optimal D -> rational fit -> scaled plant -> peak bound.
 

@@ -8,6 +8,14 @@ imaginary-axis eigenvalues of a Hamiltonian matrix.  The iteration converges
 quadratically and stops when the Hamiltonian at the raised level has no eigenvalue on
 the imaginary axis, so the returned value is within ``rtol`` of the true norm.
 
+Every computation here first balances the realization by a diagonal state similarity
+(LAPACK's ``gebal`` on ``[[A, B], [C, 0]]`` through ``scipy.linalg.matrix_balance``,
+powers of two, so exact).  Controllers from Riccati formulas have realizations whose
+states differ by 10+ decades in scale; evaluating ``C (jωI - A)⁻¹ B`` on them directly
+loses up to four digits (a distillation closed loop gave σ̄ errors of 6e-4 relative
+against a 40-digit evaluation; see tests/test_norms.py), and both the frequency response
+and the Hamiltonian test inherit that error.
+
 References
 ----------
 S. Boyd, V. Balakrishnan, "A regularity result for the singular values of a transfer
@@ -27,8 +35,9 @@ import scipy.optimize
 
 from ..errors import IterationLimitError, ParameterError
 from .checks import as_statespace
+from .scaling import state_balance
 
-__all__ = ["hinfnorm", "h2norm", "sigma_max", "is_stable"]
+__all__ = ["hinfnorm", "h2norm", "sigma_max", "freqresp", "is_stable"]
 
 logger = logging.getLogger(__name__)
 
@@ -39,13 +48,18 @@ AXIS_TOL = 1e-8
 
 
 def _matrices(sys):
+    """``A, B, C, D`` of ``sys`` in a balanced realization (see the module docstring)."""
     ss = as_statespace(sys, "sys")
     n = ss.nstates
     A = np.asarray(ss.A, dtype=float).reshape(n, n)
     B = np.asarray(ss.B, dtype=float).reshape(n, ss.ninputs)
     C = np.asarray(ss.C, dtype=float).reshape(ss.noutputs, n)
     D = np.asarray(ss.D, dtype=float).reshape(ss.noutputs, ss.ninputs)
-    return A, B, C, D
+    if n == 0 or not (np.all(np.isfinite(A)) and np.all(np.isfinite(B))
+                      and np.all(np.isfinite(C))):
+        return A, B, C, D
+    t = state_balance(A, B, C)
+    return A / t[:, None] * t[None, :], B / t[:, None], C * t[None, :], D
 
 
 def is_stable(sys, *, tol: float = STABILITY_TOL) -> bool:
@@ -77,6 +91,29 @@ def sigma_max(sys, omega) -> np.ndarray:
     """
     A, B, C, D = _matrices(sys)
     return _sigma(A, B, C, D, np.atleast_1d(np.asarray(omega, dtype=float)))
+
+
+def freqresp(sys, omega) -> np.ndarray:
+    """Frequency response ``G(j omega)`` as an ``(n_out, n_in, n_freq)`` complex array.
+
+    Evaluated on the balanced realization (see the module docstring); python-control's
+    ``frequency_response`` evaluates the realization as given.
+
+    Examples
+    --------
+    >>> import control
+    >>> G = freqresp(control.tf([1], [1, 1]), [0.0, 1.0])
+    >>> G.shape, complex(G[0, 0, 1])
+    ((1, 1, 2), (0.5-0.5j))
+    """
+    A, B, C, D = _matrices(sys)
+    omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    n = A.shape[0]
+    out = np.empty((C.shape[0], B.shape[1], omega.size), dtype=complex)
+    eye = np.eye(n)
+    for k, w in enumerate(omega):
+        out[:, :, k] = D + (C @ np.linalg.solve(1j * w * eye - A, B) if n else 0.0)
+    return out
 
 
 def _sigma(A, B, C, D, omegas):

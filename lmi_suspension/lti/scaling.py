@@ -25,7 +25,7 @@ from ..errors import DimensionError
 from .checks import as_statespace
 from .plant import GeneralizedPlant
 
-__all__ = ["PlantScaling", "scale_plant", "transform_states"]
+__all__ = ["PlantScaling", "scale_plant", "state_balance", "transform_states"]
 
 
 def _pow2(x):
@@ -33,6 +33,31 @@ def _pow2(x):
     x = np.asarray(x, dtype=float)
     x = np.where(np.isfinite(x) & (x > 0), x, 1.0)
     return np.exp2(np.round(np.log2(x)))
+
+
+def state_balance(A, B, C) -> np.ndarray:
+    """Diagonal ``T`` (powers of two) such that ``T⁻¹AT``, ``T⁻¹B``, ``CT`` are balanced.
+
+    LAPACK's ``gebal`` (``scipy.linalg.matrix_balance``, no permutation) on the square
+    matrix ``[[A, B], [C, 0]]`` padded with zeros, as MATLAB's ``ssbal`` does.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> A = np.array([[-1.0, 1e6], [0.0, -2.0]])
+    >>> T = state_balance(A, np.ones((2, 1)), np.ones((1, 2)))
+    >>> float(abs(A[0, 1] * T[1] / T[0]))  # the coupling entry of T⁻¹AT
+    61.03515625
+    """
+    A, B, C = (np.asarray(M, dtype=float) for M in (A, B, C))
+    n = A.shape[0]
+    m = max(B.shape[1], C.shape[0])
+    M = np.zeros((n + m, n + m))
+    M[:n, :n] = A
+    M[:n, n:n + B.shape[1]] = B
+    M[n:n + C.shape[0], :n] = C
+    _, (scale, _perm) = scipy.linalg.matrix_balance(M, permute=False, separate=True)
+    return _pow2(scale[:n])
 
 
 @dataclass(frozen=True)
@@ -96,15 +121,7 @@ def scale_plant(P: GeneralizedPlant, *, states: bool = True, io: bool = True
     n = A.shape[0]
     T = np.ones(n)
     if states and n:
-        B = np.hstack([b["B1"], b["B2"]])
-        C = np.vstack([b["C1"], b["C2"]])
-        m = max(B.shape[1], C.shape[0])
-        M = np.zeros((n + m, n + m))
-        M[:n, :n] = A
-        M[:n, n:n + B.shape[1]] = B
-        M[n:n + C.shape[0], :n] = C
-        _, (scale, _perm) = scipy.linalg.matrix_balance(M, permute=False, separate=True)
-        T = _pow2(scale[:n])
+        T = state_balance(A, np.hstack([b["B1"], b["B2"]]), np.vstack([b["C1"], b["C2"]]))
     Ti = 1.0 / T
     A = Ti[:, None] * A * T[None, :]
     B1, B2 = Ti[:, None] * b["B1"], Ti[:, None] * b["B2"]

@@ -628,10 +628,16 @@ def _ss_inverse(sys: control.StateSpace) -> control.StateSpace:
 
 
 def _n_unstable(sys: control.StateSpace, tol: float = 1e-9) -> int:
+    """Number of poles with ``Re p >= -tol |p|``.
+
+    The tolerance is relative to each pole, not to the largest one: a scaled plant holds
+    both a weight pole at -1e-6 rad/s and fit poles far above the grid, and a tolerance
+    relative to the fastest pole counted the slow (stable) pole as unstable.
+    """
     if sys.nstates == 0:
         return 0
     ev = np.linalg.eigvals(np.asarray(sys.A, dtype=float))
-    return int(np.sum(ev.real >= -tol * max(1.0, np.max(np.abs(ev)))))
+    return int(np.sum(ev.real >= -tol * np.abs(ev)))
 
 
 def scaled_plant(P, nmeas: int, ncon: int, dfit: DScaleFit, block_sizes,

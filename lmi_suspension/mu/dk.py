@@ -25,6 +25,7 @@ import numpy as np
 
 from ..errors import DimensionError, InfeasibleError, LmiSuspensionError, ParameterError
 from ..lti.checks import as_finite_array
+from ..lti.norms import freqresp
 from ..lti.plant import GeneralizedPlant, lft
 from .blocks import BlockStructure
 
@@ -213,22 +214,11 @@ def _block_sizes(struct: BlockStructure) -> list[tuple[int, int]]:
     return [(b.rows, b.cols) for b in struct.blocks]
 
 
-def _freqresp(sys: control.StateSpace, omega: np.ndarray) -> np.ndarray:
-    """Frequency response (n_out × n_in × n_freq) by a Hessenberg-free direct solve."""
-    A, B, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.B, sys.C, sys.D))
-    n = A.shape[0]
-    out = np.empty((C.shape[0], B.shape[1], omega.size), dtype=complex)
-    I = np.eye(n)
-    for k, w in enumerate(omega):
-        out[:, :, k] = D + (C @ np.linalg.solve(1j * w * I - A, B) if n else 0.0)
-    return out
-
-
 def _mu_bounds(CL, struct, omega, rng, M=None):
     """µ bounds of ``CL`` over ``omega``; pass its frequency response ``M`` if known."""
     from .bounds import mussv
 
-    M = _freqresp(CL, omega) if M is None else M
+    M = freqresp(CL, omega) if M is None else M
     return mussv(M, struct, omega=omega, rng=rng)
 
 
@@ -335,7 +325,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
                 raise InfeasibleError("the first K-step did not give a stabilising controller")
             stop_reason = f"K-step at iteration {it} returned a non-stabilising controller"
             break
-        M = _freqresp(CL, omega)  # one response for the D-step and the D-fit check
+        M = freqresp(CL, omega)  # one response for the D-step and the D-fit check
         mu = _mu_bounds(CL, dk_struct, omega, rng, M)
         t2 = time.perf_counter()
         upper, lower = np.asarray(mu.upper), np.asarray(mu.lower)
