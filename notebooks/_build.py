@@ -453,7 +453,7 @@ plt.show()
 ## The controller
 
 The package's µ design, `lmi_suspension.seat.design.design_mu_controller` (D-K iteration on
-the plant above with the design's weights, `DEFAULT_DESIGN`), takes about 60–75 s. To keep this
+the plant above with the design's weights, `DEFAULT_DESIGN`), takes about 10–30 s. To keep this
 notebook short its result is stored next to it in `controller.json` (with the µ bounds of the
 design in the metadata; regenerate with `python _build.py --controller`). If the file is
 missing the design is run here.

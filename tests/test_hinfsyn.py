@@ -258,3 +258,49 @@ def test_polish_after_an_inaccurate_gamma_minimisation():
     reference = hinfnorm(lft(P, ric.K))[0]
     assert lmi.gamma <= reference * 1.005
     assert lmi.gamma < lmi.gamma_lower  # the γ minimisation really was inaccurate here
+
+
+def test_riccati_probes_recover_a_destabilising_python_control_controller():
+    # Found by scanning random_plant(4, 2, 1, 2, 1) seeds 100-139 (2026-11-23): on 13 of
+    # 40, python-control's hinfsyn returns a controller that does NOT stabilise the plant
+    # (its γ-optimal formulas are ill-conditioned); seed 104 is one.  The suboptimal
+    # controller at 1.001 γ (SLICOT sb10ad, job=4) is stable and certifies there; the
+    # independent reference is the LMI route's certified γ on the same plant.
+    P = random_plant(4, 2, 1, 2, 1, rng=np.random.default_rng(104))
+    plain = hinfsyn(P, 1, 1, method="riccati")
+    assert plain.gamma == np.inf  # the defect of the baseline, measured by hinfnorm
+    probed = hinfsyn(P, 1, 1, method="riccati",
+                     options=HinfsynOptions(riccati_probes=(1e-3, 1e-2, 0.1)))
+    assert_certified(probed, P)
+    assert probed.gamma <= probed.gamma_solver * 1.001 * (1 + 1e-6)
+    assert any("riccati probe" in w for w in probed.warnings)
+    lmi = hinfsyn(P, 1, 1)
+    assert probed.gamma == pytest.approx(lmi.gamma, rel=5e-3)
+
+
+def test_riccati_at_a_fixed_gamma():
+    # Skogestad & Postlethwaite (2005), Sec. 8.12.4: the plain H∞ problem of the
+    # distillation example has γ_opt ≈ 1.18 (their first D-K iteration), so a
+    # controller exists at 1.2 and none at 1.1.
+    from lmi_suspension.examples import skogestad_distillation
+    from lmi_suspension.errors import InfeasibleError
+
+    ex = skogestad_distillation()
+    res = hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati",
+                  options=HinfsynOptions(gamma=1.2))
+    assert_certified(res, ex.P)
+    assert res.gamma_solver == 1.2 and res.gamma <= 1.2
+    with pytest.raises(InfeasibleError):
+        hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati", options=HinfsynOptions(gamma=1.1))
+
+
+def test_gamma_abort_stops_the_lmi_route_above_a_known_level():
+    # DGKF closed form (see scalar_gamma_opt): a level below γ_opt cannot be achieved,
+    # so an optimum above it means the solve is declared failed at once.
+    from lmi_suspension.errors import SolverError
+
+    P = scalar_plant(1.0)
+    with pytest.raises(SolverError, match="known to be achievable"):
+        hinfsyn(P, 1, 1, options=HinfsynOptions(gamma_abort=0.9 * scalar_gamma_opt(1.0)))
+    res = hinfsyn(P, 1, 1, options=HinfsynOptions(gamma_abort=1.1 * scalar_gamma_opt(1.0)))
+    assert res.gamma == pytest.approx(scalar_gamma_opt(1.0), rel=5e-3)

@@ -9,6 +9,7 @@ import pytest
 from lmi_suspension.errors import AssumptionError, DimensionError, ParameterError
 from lmi_suspension.examples import skogestad_distillation
 from lmi_suspension.lti import lft
+from mp_reference import freqresp_mp
 from lmi_suspension.mu import MusynOptions, mussv, musyn
 from lmi_suspension.synthesis import hinfsyn
 
@@ -17,27 +18,36 @@ from lmi_suspension.synthesis import hinfsyn
 def distillation_design():
     ex = skogestad_distillation()
     records = []
-    omega = np.logspace(-3, 3, 61)  # the grid of dkpy's example of the same problem
+    omega = np.logspace(-3, 3, 61)  # the book's grid (and dkpy's example of the problem)
     res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=omega,
-                options=MusynOptions(max_iter=3, method="riccati"),
+                options=MusynOptions(max_iter=6, patience=3, method="best"),
                 callback=records.append)
     return ex, res, records
+
+
+# Published D-K iterations on this problem, same 61-point grid 1e-3..1e3 rad/s, 4th-order
+# fits of d1 and d2: Skogestad & Postlethwaite (2005), Table 8.2 (µ 1.1818, 1.0238,
+# 1.0189), and the book's companion script Sec8_124.m: µ = 1.1798, 1.0275, 1.0207,
+# 1.0130, 1.0069, 1.0023, 0.9998, ... -- below 1 only from iteration 7.
+PUBLISHED_MU_ITER1 = 1.1798
+PUBLISHED_MU_ITER2 = 1.0275
 
 
 @pytest.mark.slow
 def test_distillation_improves_on_the_open_source_plateau(distillation_design):
     """Skogestad & Postlethwaite (2005), Sec. 8.12.4, Table 8.1 problem.
 
-    References: the first K-step is the plain H∞ problem, whose optimum S&P report as
-    γ ≈ 1.18; MATLAB's musyn brings µ below 1, the open-source peer (dkpy) stalls near
-    1.04 (both as quoted in this project's issue #5).  Measured here: 1.1792 after the
-    first iteration, 1.0291 after three.  The MATLAB level is NOT reached yet: the K-step
-    on the D-scaled plant (a weight pole at -1e-6 rad/s) is where both of our routes lose
-    accuracy; this test pins what is achieved so that regressions show.
+    The first K-step is the plain H∞ problem; iterations 1-2 match the book's script
+    within 1 %.  The open-source peer (dkpy) stalls near 1.04 (issue #5); measured here
+    (2026-11-23): 1.0265 at iteration 4, where the book has 1.0130.  The MATLAB level
+    (µ < 1 from iteration 7) is NOT reached: from iteration 5 every K-step route is
+    worse on the D-scaled plant (a weight pole at -1e-6 rad/s, 22 states) than keeping
+    the previous controller, and the loop stops there (test_kstep_regression_...).
     """
     ex, res, _ = distillation_design
-    assert res.history[0].mu_peak == pytest.approx(1.18, rel=0.01)
-    assert res.mu_peak < 1.04
+    assert res.history[0].mu_peak == pytest.approx(PUBLISHED_MU_ITER1, rel=0.005)
+    assert res.history[1].mu_peak == pytest.approx(PUBLISHED_MU_ITER2, rel=0.01)
+    assert res.mu_peak < 1.03
     # lower <= upper everywhere, and for three complex full blocks µ's upper bound is
     # tight, so the two bounds agree closely at the peak (independent certificate).
     assert np.all(res.mu.lower <= res.mu.upper * (1 + 1e-9))
@@ -45,6 +55,34 @@ def test_distillation_improves_on_the_open_source_plateau(distillation_design):
     # The returned closed loop is lft(P, K) and stable.
     np.testing.assert_allclose(res.CL(1j * 0.3), lft(ex.P, res.K)(1j * 0.3), rtol=1e-9)
     assert np.all(res.CL.poles().real < 0)
+
+
+@pytest.mark.slow
+def test_returned_mu_holds_off_the_design_grid(distillation_design):
+    """The weight pole at -1e-6 rad/s lies three decades below the design grid.
+    Independent check: µ of the returned closed loop far below and above the grid,
+    from a 40-digit evaluation of the loop (its controller has poles up to ~5e6 rad/s, so
+    a double-precision response is off by up to 5e-3 below 1e-5 rad/s, measured),
+    stays within the reported peak."""
+    ex, res, _ = distillation_design
+    w = np.array([1e-9, 1e-7, 1e-5, 1e4, 1e6])
+    off = mussv(freqresp_mp(res.CL, w), ex.blk)
+    assert np.max(off.upper) <= res.mu_peak * (1 + 1e-6)
+
+
+@pytest.mark.slow
+def test_kstep_regression_stops_the_loop(distillation_design):
+    """An exact K-step never does worse on the scaled plant than the previous controller,
+    whose scaled norm (gamma_prev, a separate hinfnorm) is recorded."""
+    _, res, _ = distillation_design
+    h = res.history
+    assert np.isnan(h[0].gamma_prev)
+    assert all(np.isfinite(r.gamma_prev) for r in h[1:])
+    regressed = [r.index for r in h[1:] if r.gamma > r.gamma_prev * (1 + 1e-3)]
+    if regressed:  # the loop stops at the first one, and says why
+        assert regressed == [h[-1].index]
+        assert "K-step" in res.stop_reason
+    assert res.best_iteration not in regressed
 
 
 @pytest.mark.slow

@@ -25,13 +25,19 @@ import numpy as np
 
 from ..errors import DimensionError, InfeasibleError, LmiSuspensionError, ParameterError
 from ..lti.checks import as_finite_array
-from ..lti.norms import freqresp
+from ..lti.norms import freqresp, hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
 from .blocks import BlockStructure
 
 logger = logging.getLogger(__name__)
 
 __all__ = ["MusynOptions", "MusynIteration", "MusynResult", "musyn", "default_omega"]
+
+#: Suboptimal levels ``(1 + r) γ`` that the Riccati K-step also tries when its γ-optimal
+#: controller certifies above its own γ (see ``HinfsynOptions.riccati_probes``).
+KSTEP_RICCATI_PROBES = (1e-3, 3e-3, 1e-2, 3e-2, 0.1)
+#: relative slack before a K-step counts as worse than keeping the previous controller
+_KSTEP_RTOL = 1e-3
 
 
 @dataclass(frozen=True)
@@ -50,10 +56,13 @@ class MusynOptions:
     min_improvement : float
         Relative improvement that counts as progress.
     method : {"lmi", "riccati", "best"}
-        K-step method of :func:`hinfsyn`; ``"best"`` runs both and keeps the controller
-        with the lower certified closed-loop γ.
+        K-step method of :func:`hinfsyn`; ``"best"`` runs the Riccati route on the scaled
+        plant as given and balanced, then the LMI route (abandoned when its γ
+        minimisation stops above twice a certified Riccati γ), and keeps the controller
+        with the lowest certified closed-loop γ.
     hinfsyn_options : HinfsynOptions or None
-        Options passed to every K-step.
+        Options passed to every K-step (default: ``HinfsynOptions`` with
+        ``riccati_probes = KSTEP_RICCATI_PROBES``).
     max_dfit_order : int
         Largest order of each D-scale fit.
     dfit_rtol : float
@@ -67,6 +76,11 @@ class MusynOptions:
         when its µ peak stays within ``reduce_mu_tol`` (relative) of the full-order one.
     reduce_mu_tol : float
         Relative µ increase tolerated by the order reduction.
+    stop_on_kstep_regression : bool
+        Stop when a K-step's controller is worse on the scaled plant ``P_D`` than the
+        previous controller (``gamma > gamma_prev`` by more than 0.1 %): an exact K-step
+        never is, so the K-step has lost accuracy there and D-scales fitted to its
+        controller lead away from the optimum.  The best iterate is returned either way.
     """
 
     max_iter: int = 8
@@ -80,6 +94,7 @@ class MusynOptions:
     n_dense: int = 400
     reduce_order: int | None = None
     reduce_mu_tol: float = 0.02
+    stop_on_kstep_regression: bool = True
 
     def __post_init__(self):
         if int(self.max_iter) < 1 or int(self.patience) < 1:
@@ -106,6 +121,9 @@ class MusynIteration:
     gamma : float
         Certified H∞ norm of the D-scaled closed loop (an upper bound of µ at every
         frequency, not just on the grid, for the fitted D-scales).
+    gamma_prev : float
+        Certified H∞ norm of the *previous* controller on this iteration's scaled plant
+        (``nan`` on the first iteration): the level an exact K-step matches or beats.
     mu_peak, mu_lower_peak : float
         Peak of the µ upper and lower bounds on the design grid.
     peak_omega : float
@@ -132,6 +150,7 @@ class MusynIteration:
     seconds_d: float
     seconds_fit: float
     warnings: tuple = ()
+    gamma_prev: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -307,8 +326,12 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     best = None  # (mu_peak, K, index)
     stop_reason = f"reached max_iter={opts.max_iter}"
     since_best = 0
+    K_prev = None
     for it in range(1, int(opts.max_iter) + 1):
         t0 = time.perf_counter()
+        # what the previous controller achieves on the new scaled plant
+        gamma_prev = (float(hinfnorm(lft(PD, K_prev, nmeas, ncon))[0]) if K_prev is not None
+                      else float("nan"))
         try:
             syn = _k_step(hinfsyn, PD, nmeas, ncon, opts)
         except LmiSuspensionError as exc:
@@ -338,8 +361,15 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
         since_best = 0 if improved else since_best + 1
 
         done = None
+        regressed = (opts.stop_on_kstep_regression and np.isfinite(gamma_prev)
+                     and syn.gamma > gamma_prev * (1 + _KSTEP_RTOL))
         if mu_peak < opts.mu_target:
             done = f"µ peak {mu_peak:.4f} below target {opts.mu_target}"
+        elif regressed:
+            done = (f"the K-step at iteration {it} is worse on the scaled plant than the "
+                    f"previous controller (gamma {syn.gamma:.4f} > {gamma_prev:.4f}): it "
+                    "has lost accuracy on this scaled plant")
+            logger.warning("musyn: %s", done)
         elif since_best >= opts.patience:
             done = f"no improvement of {opts.min_improvement:.1%} in {opts.patience} iterations"
         elif it == opts.max_iter:
@@ -361,11 +391,14 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
             index=it, gamma=float(syn.gamma), mu_peak=mu_peak,
             mu_lower_peak=float(np.max(lower)), peak_omega=float(omega[k_peak]),
             dfit_orders=orders, controller_order=K.nstates, seconds_k=t1 - t0,
-            seconds_d=t2 - t1, seconds_fit=t4 - t3, warnings=tuple(syn.warnings))
+            seconds_d=t2 - t1, seconds_fit=t4 - t3, warnings=tuple(syn.warnings),
+            gamma_prev=gamma_prev)
         history.append(record)
-        logger.info("musyn iteration %d: gamma=%.4f mu=%.4f (lower %.4f) K order %d "
-                    "D orders %s [K %.2fs, D %.2fs, fit %.2fs]", it, record.gamma, mu_peak,
-                    record.mu_lower_peak, K.nstates, orders, record.seconds_k,
+        K_prev = K
+        logger.info("musyn iteration %d: gamma=%.4f (previous K %.4f) mu=%.4f (lower %.4f) "
+                    "K order %d D orders %s [K %.2fs, D %.2fs, fit %.2fs]", it, record.gamma,
+                    gamma_prev, mu_peak, record.mu_lower_peak, K.nstates, orders,
+                    record.seconds_k,
                     record.seconds_d, record.seconds_fit)
         if callback is not None:
             callback(record)
@@ -400,20 +433,24 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
 
 
 def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions):
-    """H∞ synthesis on the scaled plant. With ``method="best"`` both the LMI and the
-    Riccati routes run and the controller with the lower *certified* γ is kept (each
-    route fails on problems the other solves: singular D12/D21 for Riccati, slow
-    near-integrator weights for the LMI)."""
-    if opts.method != "best":
-        return hinfsyn(PD, nmeas, ncon, method=opts.method, options=opts.hinfsyn_options)
-    results, errors = [], []
+    """H∞ synthesis on the scaled plant. With ``method="best"`` the LMI route and the
+    Riccati route on the plant as given and balanced all run, and the controller with
+    the lowest *certified* γ is kept: each fails on problems another solves (singular
+    D12/D21 for Riccati; D-scaled plants with a slow weight pole, where Clarabel's γ
+    minimisation stalls and either Riccati variant can be the accurate one)."""
     from ..synthesis import HinfsynOptions
 
-    base = opts.hinfsyn_options if opts.hinfsyn_options is not None else HinfsynOptions()
-    for method in ("lmi", "riccati"):
+    base = (opts.hinfsyn_options if opts.hinfsyn_options is not None
+            else HinfsynOptions(riccati_probes=KSTEP_RICCATI_PROBES))
+    if opts.method != "best":
+        return hinfsyn(PD, nmeas, ncon, method=opts.method, options=base)
+    results, errors = [], []
+    for method, scale in (("riccati", False), ("riccati", True), ("lmi", None)):
+        options = replace(base, riccati_scale=scale) if method == "riccati" else base
+        if method == "lmi" and results and base.gamma is None:
+            # an LMI optimum far above a certified Riccati γ is a failed solve: stop early
+            options = replace(base, gamma_abort=2.0 * min(r.gamma for r in results))
         try:
-            # the Riccati candidate sees the balanced plant (its γ is certified anyway)
-            options = base if method == "lmi" else replace(base, riccati_scale=True)
             results.append(hinfsyn(PD, nmeas, ncon, method=method, options=options))
         except LmiSuspensionError as exc:
             errors.append(exc)

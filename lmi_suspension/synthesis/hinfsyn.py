@@ -140,19 +140,20 @@ def hinfsyn(P, nmeas: int, ncon: int, *, method: str = "lmi",
 
 
 # --------------------------------------------------------------------------- riccati
-def _hinfsyn_riccati(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> HinfsynResult:
-    check_riccati_assumptions(G)
-    warnings: list[str] = []
-    t1 = time.perf_counter()
+def _sb10ad(Gs: GeneralizedPlant, gamma: float | None):
+    """``(K, gamma)`` from SLICOT: python-control's γ-optimal ``hinfsyn`` when ``gamma`` is
+    None, else ``sb10ad``'s suboptimal controller at ``gamma`` (``job=4``)."""
     try:
-        if opts.riccati_scale:
-            # Same balancing as the LMI route; the baseline proper (default) sees the
-            # plant exactly as the user gave it.
-            Gs, sc = scale_plant(G)
-            Ks, _CL, gam, _rcond = control.hinfsyn(Gs.sys, G.ny, G.nu)
-            K, gam = sc.controller_to_original(Ks), float(gam) / sc.gamma_factor
-        else:
-            K, _CL, gam, _rcond = control.hinfsyn(G.sys, G.ny, G.nu)
+        if gamma is None:
+            K, _CL, gam, _rcond = control.hinfsyn(Gs.sys, Gs.ny, Gs.nu)
+            return K, float(gam)
+        from slycot import sb10ad
+
+        A, B, C, D = (np.asarray(M, dtype=float) for M in (Gs.sys.A, Gs.sys.B, Gs.sys.C,
+                                                            Gs.sys.D))
+        out = sb10ad(A.shape[0], B.shape[1], C.shape[0], Gs.nu, Gs.ny, float(gamma),
+                     A, B, C, D, job=4)
+        return control.ss(*out[1:5]), float(gamma)
     except (ValueError, ArithmeticError, control.ControlArgument) as exc:
         msg = str(exc)
         low = msg.lower()
@@ -163,12 +164,43 @@ def _hinfsyn_riccati(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hi
         if type(exc).__module__.startswith("slycot"):
             raise SolverError(f"slycot sb10ad failed: {exc}") from exc
         raise
+
+
+def _hinfsyn_riccati(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> HinfsynResult:
+    check_riccati_assumptions(G)
+    warnings: list[str] = []
+    t1 = time.perf_counter()
+    # Same balancing as the LMI route on request; the baseline proper (default) sees the
+    # plant exactly as the user gave it.
+    Gs, sc = scale_plant(G) if opts.riccati_scale else (G, None)
+    factor = sc.gamma_factor if sc is not None else 1.0
+
+    def synthesise(gamma):
+        Ks, gam = _sb10ad(Gs, None if gamma is None else gamma * factor)
+        return (sc.controller_to_original(Ks) if sc is not None else Ks), gam / factor
+
+    K, gam = synthesise(opts.gamma)
     t2 = time.perf_counter()
-    gam = float(gam)
     CL, gamma, poles = _certify(G, K, gam, opts, warnings, "riccati")
     if np.isfinite(gamma) and gamma > gam * 1.01:
         warnings.append(f"riccati: controller is {100 * (gamma / gam - 1):.3g} % above "
                         "its own gamma")
+    if opts.gamma is None and opts.riccati_probes and not gamma <= gam * (1 + opts.cert_rtol):
+        # At the optimum the controller formulas are ill-conditioned; suboptimal levels
+        # give other, often far better, controllers (certified like the first).
+        for r in opts.riccati_probes:
+            try:
+                Kr, _ = synthesise(gam * (1.0 + r))
+            except (InfeasibleError, SolverError) as exc:
+                warnings.append(f"riccati probe at (1 + {r:g}) gamma: {exc}")
+                continue
+            probe_warn: list[str] = []
+            CLr, gamma_r, poles_r = _certify(G, Kr, gam * (1.0 + r), opts, probe_warn,
+                                             "riccati")
+            if gamma_r < gamma:
+                warnings.append(f"riccati probe at (1 + {r:g}) gamma: certified "
+                                f"{gamma_r:.6g} (was {gamma:.6g})")
+                K, CL, gamma, poles = Kr, CLr, gamma_r, poles_r
     t3 = time.perf_counter()
     return HinfsynResult(K=K, CL=CL, gamma=gamma, gamma_solver=gam, gamma_lower=None,
                          poles=poles, status="optimal", method="riccati",
@@ -261,6 +293,10 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
             sol = _lmi.gamma_lmi(Ps, opts)
         warnings += list(sol.warnings)
         gamma_lower: float | None = sol.gamma / sc.gamma_factor
+        if opts.gamma_abort is not None and gamma_lower > opts.gamma_abort:
+            raise SolverError(f"the γ minimisation stopped at {gamma_lower:.6g}, above the "
+                              f"level {opts.gamma_abort:.6g} known to be achievable: the LMI "
+                              "solve is inaccurate on this plant")
         relax = opts.gamma_relax
         tiny_optimum = sol.gamma <= opts.gamma_atol
         if tiny_optimum:

@@ -20,7 +20,8 @@ class HinfsynOptions:
     Attributes
     ----------
     gamma : float or None
-        Fixed performance level; ``None`` minimises γ (LMI method only).
+        Fixed performance level; ``None`` minimises γ.  With ``method="riccati"`` the
+        controller is SLICOT ``sb10ad``'s suboptimal one at this level (``job=4``).
     gamma_relax : float
         Relative relaxation of the LMI optimum used to reconstruct a well-conditioned
         controller; the certified γ stays below ``(1 + gamma_relax) * gamma_lower``
@@ -58,6 +59,18 @@ class HinfsynOptions:
         ``method="riccati"`` only: balance the plant (as the LMI route does) before
         python-control sees it. Off by default so that the baseline is python-control
         exactly as users call it.
+    riccati_probes : tuple of float
+        ``method="riccati"`` with ``gamma=None`` only: when python-control's controller
+        certifies more than ``cert_rtol`` above its own γ (its formulas are
+        ill-conditioned at the optimum), the suboptimal controllers at
+        ``(1 + r) γ`` for each ``r`` here are also computed and certified, and the
+        lowest certified one is returned.  Empty by default (the plain baseline);
+        :func:`~lmi_suspension.mu.musyn` turns it on for its K-steps.
+    gamma_abort : float or None
+        ``method="lmi"`` only: raise :class:`~lmi_suspension.errors.SolverError` as soon as
+        the γ minimisation's optimum exceeds this level (a γ another controller is
+        certified to achieve: the minimisation has then failed, and reconstructing
+        around it is wasted time).  Used by ``musyn``'s ``method="best"``.
     polish_steps : int
         When the reconstructed controller certifies *below* the LMI optimum (the γ
         minimisation stopped early), up to this many re-solves of the controller LMI at a
@@ -87,6 +100,8 @@ class HinfsynOptions:
     scale: bool = True
     cert_rtol: float = 5e-3
     riccati_scale: bool = False
+    riccati_probes: tuple = ()
+    gamma_abort: float | None = None
     polish_steps: int = 4
     polish_step: float = 0.01
     direct_solve_method: str = "faer"
@@ -103,6 +118,11 @@ class HinfsynOptions:
         if self.direct_solve_method not in ("faer", "qdldl"):
             raise ParameterError("direct_solve_method must be 'faer' or 'qdldl', got "
                                  f"{self.direct_solve_method!r}")
+        if self.gamma_abort is not None and not self.gamma_abort > 0:
+            raise ParameterError(f"gamma_abort must be positive, got {self.gamma_abort!r}")
+        if not all(np.isfinite(r) and r > 0 for r in self.riccati_probes):
+            raise ParameterError("riccati_probes must be positive relative steps, got "
+                                 f"{self.riccati_probes!r}")
         if not self.polish_step < 1 or int(self.polish_steps) < 0:
             raise ParameterError("polish_step must be in (0, 1) and polish_steps >= 0")
         if int(self.max_iter) < 1 or int(self.max_recoveries) < 0:
