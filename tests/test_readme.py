@@ -3,6 +3,8 @@
 import re
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -25,3 +27,15 @@ def test_ci_runs_quickstart_line_two():
     commands = [c for c in ci if c.strip() and not c.startswith("#")
                 and not c.startswith(("set ", "cd ", "export "))]
     assert commands == [quickstart_lines()[1]]
+
+
+@pytest.mark.slow  # the snippet runs a D-K iteration (≈ 40 s)
+def test_using_it_snippet_runs():
+    """The README's Python example runs as printed (its own assert included)."""
+    text = (ROOT / "README.md").read_text()
+    section = text.split("## Using it", 1)[1]
+    code = re.search(r"```python\n(.*?)```", section, re.S).group(1)
+    namespace: dict = {}
+    exec(compile(code, "README.md", "exec"), namespace)
+    res = namespace["res"]
+    assert res.mu_lower_peak <= res.mu_peak < 1.04  # below the open-source plateau
