@@ -24,10 +24,12 @@ DATA = Path(__file__).parents[2] / "shared" / "data" / "compleib_subset.json"
 RELAX = HinfsynOptions().gamma_relax
 PROBLEMS = ["AC1", "AC2", "AC3", "AC4", "AC6", "HE1", "HE2", "REA1", "REA2", "DIS1",
             "NN1", "NN2"]
-# Certified γ within 0.5 % of the LMI optimum (the reconstruction target); measured
-# by `python benchmarks/compleib_table.py`: at most 0.27 % (AC6, HE1) with the default
-# gamma_relax = 0.3 %.
-BUDGET = 0.005
+# Certified γ within 0.1 % of the LMI optimum (the target for this library), with
+# the default tightening probe; HE1 keeps the 0.5 % reconstruction budget (its
+# controller LMI is infeasible near the optimum within any trace box tried). Measured by
+# `python benchmarks/compleib_table.py` (2026-11-23): at most 0.07 % (AC3, AC6), HE1 0.27 %.
+BUDGET = {"HE1": 0.005}
+DEFAULT_BUDGET = 0.001
 
 
 def load(name):
@@ -51,7 +53,7 @@ def test_compleib_certified_gamma(name):
         # unbounded X, Y): the best known value is python-control's Riccati controller,
         # certified in test_compleib_ac4_against_riccati
         return
-    assert res.gamma <= res.gamma_lower * (1 + BUDGET)
+    assert res.gamma <= res.gamma_lower * (1 + BUDGET.get(name, DEFAULT_BUDGET))
 
 
 def test_compleib_ac4_against_riccati():

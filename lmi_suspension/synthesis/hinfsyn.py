@@ -209,6 +209,28 @@ def _hinfsyn_riccati(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hi
 
 
 # --------------------------------------------------------------------------- lmi
+def _probe(G: GeneralizedPlant, sc: PlantScaling, used: tuple, g_try: float,
+           opts: HinfsynOptions):
+    """Re-solve the (already compiled) controller LMI at ``g_try`` and certify.
+
+    Returns ``(result tuple or None, description)``; ``None`` when the solve fails or
+    the closed loop is unstable."""
+    lmi_k, trace_bound = used
+    tc = time.perf_counter()
+    probe_warn: list[str] = []
+    try:
+        Ks, cond_xy, status, cwarn = lmi_k.controller(g_try * sc.gamma_factor, trace_bound,
+                                                      opts)
+        K = _undo_loop_shift(sc.controller_to_original(Ks), G.D22)
+        CL, gamma, poles = _certify(G, K, g_try, opts, probe_warn, "lmi")
+    except (InfeasibleError, SolverError, np.linalg.LinAlgError) as exc:
+        return None, str(exc)
+    if not np.isfinite(gamma):
+        return None, "; ".join(probe_warn)
+    return ((K, CL, gamma, poles, g_try, status, cond_xy, float("nan"),
+             time.perf_counter() - tc), f"certified {gamma:.6g}")
+
+
 def _polish(G: GeneralizedPlant, sc: PlantScaling, used: tuple, result: tuple,
             opts: HinfsynOptions, warnings: list) -> tuple:
     """Probe lower levels after an inaccurate γ minimisation.
@@ -220,31 +242,36 @@ def _polish(G: GeneralizedPlant, sc: PlantScaling, used: tuple, result: tuple,
     certified level, at most ``polish_steps`` times, starting from ``polish_step`` and
     halving the step after every probe that does not certify lower.
     """
-    lmi_k, trace_bound = used
     step = opts.polish_step
     for k in range(int(opts.polish_steps)):
         best = result[2]
         g_try = best * (1.0 - step)
-        tc = time.perf_counter()
-        probe_warn: list[str] = []
-        try:
-            Ks, cond_xy, status, cwarn = lmi_k.controller(g_try * sc.gamma_factor, trace_bound,
-                                                          opts)
-            K = _undo_loop_shift(sc.controller_to_original(Ks), G.D22)
-            CL, gamma, poles = _certify(G, K, g_try, opts, probe_warn, "lmi")
-        except (InfeasibleError, SolverError, np.linalg.LinAlgError) as exc:
-            gamma, why = float("inf"), str(exc)
-        else:
-            why = f"certified {gamma:.6g}"
-        if not gamma < best:
+        probe, why = _probe(G, sc, used, g_try, opts)
+        if probe is None or not probe[2] < best:
             # below the infimum, or too close to it for the solver: halve the step
             warnings.append(f"polish probe {k + 1} at gamma={g_try:.6g}: {why}")
             step /= 2.0
             continue
-        warnings.append(f"polish probe {k + 1}: certified {gamma:.6g} (was {best:.6g})")
-        warnings += list(cwarn) + probe_warn
-        result = (K, CL, gamma, poles, g_try, status, cond_xy, float("nan"),
-                  time.perf_counter() - tc)
+        warnings.append(f"polish probe {k + 1}: certified {probe[2]:.6g} (was {best:.6g})")
+        result = probe
+    return result
+
+
+def _tighten(G: GeneralizedPlant, sc: PlantScaling, used: tuple, result: tuple,
+             gamma_lower: float, opts: HinfsynOptions, warnings: list) -> tuple:
+    """One reconstruction nearer the optimum when the certified γ is more than
+    ``tighten_rtol`` above it (the relaxation that keeps the controller well
+    conditioned costs up to ``gamma_relax``); kept only if it certifies lower."""
+    g_try = gamma_lower * (1.0 + 0.8 * opts.tighten_rtol)
+    lmi_k, trace_bound = used
+    for factor in (10.0, 1000.0):
+        # nearer the optimum X and Y grow: widen the trace box that bounds them
+        probe, why = _probe(G, sc, (lmi_k, trace_bound * factor), g_try, opts)
+        if probe is not None and probe[2] < result[2]:
+            warnings.append(f"tightened: certified {probe[2]:.6g} at gamma={g_try:.6g} "
+                            f"(was {result[2]:.6g})")
+            return probe
+    warnings.append(f"tightening at gamma={g_try:.6g} kept the first controller: {why}")
     return result
 
 
@@ -371,6 +398,10 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
         warnings.append(f"certified gamma {result[2]:.6g} is below the LMI optimum "
                         f"{gamma_lower:.6g}: the γ minimisation was inaccurate")
         result = _polish(G, sc, used, result, opts, warnings)
+    elif opts.gamma is None and gamma_lower is not None and used is not None \
+            and not tiny_optimum and opts.tighten_rtol > 0 \
+            and result[2] > gamma_lower * (1.0 + opts.tighten_rtol):
+        result = _tighten(G, sc, used, result, gamma_lower, opts, warnings)
     K, CL, gamma, poles, g_ctrl, status, cond_xy, cond_lyap, t_cert = result
     t_rec = time.perf_counter() - t2 - t_cert
     return HinfsynResult(

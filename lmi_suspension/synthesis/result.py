@@ -71,6 +71,10 @@ class HinfsynOptions:
         the γ minimisation's optimum exceeds this level (a γ another controller is
         certified to achieve: the minimisation has then failed, and reconstructing
         around it is wasted time).  Used by ``musyn``'s ``method="best"``.
+    tighten_rtol : float
+        When the certified γ is more than this (relative) above the LMI optimum, one
+        more controller is reconstructed at ``(1 + 0.8 tighten_rtol)`` times the optimum
+        and kept if it certifies lower (``0`` disables).
     polish_steps : int
         When the reconstructed controller certifies *below* the LMI optimum (the γ
         minimisation stopped early), up to this many re-solves of the controller LMI at a
@@ -102,6 +106,7 @@ class HinfsynOptions:
     riccati_scale: bool = False
     riccati_probes: tuple = ()
     gamma_abort: float | None = None
+    tighten_rtol: float = 1e-3
     polish_steps: int = 4
     polish_step: float = 0.01
     direct_solve_method: str = "faer"
@@ -118,6 +123,8 @@ class HinfsynOptions:
         if self.direct_solve_method not in ("faer", "qdldl"):
             raise ParameterError("direct_solve_method must be 'faer' or 'qdldl', got "
                                  f"{self.direct_solve_method!r}")
+        if not (np.isfinite(self.tighten_rtol) and self.tighten_rtol >= 0):
+            raise ParameterError(f"tighten_rtol must be >= 0, got {self.tighten_rtol!r}")
         if self.gamma_abort is not None and not self.gamma_abort > 0:
             raise ParameterError(f"gamma_abort must be positive, got {self.gamma_abort!r}")
         if not all(np.isfinite(r) and r > 0 for r in self.riccati_probes):
