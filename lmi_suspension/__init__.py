@@ -8,12 +8,12 @@ Data flow: model (:mod:`lmi_suspension.seat`) -> generalized plant
 
 from . import errors
 from .errors import LmiSuspensionError
-from .lti import GeneralizedPlant, hinfnorm, lft
+from .lti import GeneralizedPlant, freqresp, hinfnorm, lft
 from .mu import MusynOptions, MussvOptions, mussv, musyn
 from .synthesis import HinfsynOptions, HinfsynResult, hinfsyn
 
 __version__ = "0.1.0"
 
-__all__ = ["GeneralizedPlant", "lft", "hinfnorm", "hinfsyn", "HinfsynOptions", "HinfsynResult",
+__all__ = ["GeneralizedPlant", "lft", "hinfnorm", "freqresp", "hinfsyn", "HinfsynOptions", "HinfsynResult",
            "mussv", "MussvOptions", "musyn", "MusynOptions", "LmiSuspensionError", "errors",
            "__version__"]

@@ -2,6 +2,6 @@
 
 from .checks import as_statespace
 from .plant import GeneralizedPlant, lft
-from .norms import hinfnorm
+from .norms import freqresp, hinfnorm
 
-__all__ = ["GeneralizedPlant", "lft", "as_statespace", "hinfnorm"]
+__all__ = ["GeneralizedPlant", "lft", "as_statespace", "hinfnorm", "freqresp"]
