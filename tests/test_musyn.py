@@ -9,6 +9,7 @@ import pytest
 from lmi_suspension.errors import AssumptionError, DimensionError, ParameterError
 from lmi_suspension.examples import skogestad_distillation
 from lmi_suspension.lti import lft
+from lmi_suspension.lti.norms import freqresp
 from mp_reference import freqresp_mp
 from lmi_suspension.mu import MusynOptions, mussv, musyn
 from lmi_suspension.synthesis import hinfsyn
@@ -53,7 +54,12 @@ def test_distillation_improves_on_the_open_source_plateau(distillation_design):
     assert np.all(res.mu.lower <= res.mu.upper * (1 + 1e-9))
     assert res.mu_lower_peak >= 0.97 * res.mu_peak
     # The returned closed loop is lft(P, K) and stable.
-    np.testing.assert_allclose(res.CL(1j * 0.3), lft(ex.P, res.K)(1j * 0.3), rtol=1e-9)
+    # (checked against a 40-digit evaluation of lft(P, K): the controller's poles reach
+    # ~5e6 rad/s and the loop's slowest are at 1e-6 rad/s, so even the balanced
+    # double-precision response is off by ~1e-5 relative at 1e-3 rad/s, measured)
+    w = np.array([1e-3, 0.3, 30.0])
+    exact = freqresp_mp(lft(ex.P, res.K), w)
+    np.testing.assert_allclose(freqresp(res.CL, w), exact, rtol=0, atol=1e-4 * np.abs(exact).max())
     assert np.all(res.CL.poles().real < 0)
 
 

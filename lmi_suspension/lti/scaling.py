@@ -25,7 +25,8 @@ from ..errors import DimensionError
 from .checks import as_statespace
 from .plant import GeneralizedPlant
 
-__all__ = ["PlantScaling", "scale_plant", "state_balance", "transform_states"]
+__all__ = ["PlantScaling", "balanced_statespace", "scale_plant", "state_balance",
+           "transform_states"]
 
 
 def _pow2(x):
@@ -58,6 +59,28 @@ def state_balance(A, B, C) -> np.ndarray:
     M[n:n + C.shape[0], :n] = C
     _, (scale, _perm) = scipy.linalg.matrix_balance(M, permute=False, separate=True)
     return _pow2(scale[:n])
+
+
+def balanced_statespace(sys: control.StateSpace) -> control.StateSpace:
+    """``sys`` after the diagonal state similarity of :func:`state_balance`.
+
+    Same transfer function (powers of two, so the matrices are exact); evaluations of
+    ``C (sI - A)⁻¹ B`` on the result, python-control's included, are far more accurate
+    when the original states span many decades of scale.
+
+    Examples
+    --------
+    >>> import control, numpy as np
+    >>> G = control.ss([[-1.0, 1e6], [0.0, -2.0]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]])
+    >>> Gb = balanced_statespace(G)
+    >>> bool(np.isclose(complex(Gb(1j)), complex(G(1j))))
+    True
+    """
+    A, B, C, D = (np.asarray(M, dtype=float) for M in (sys.A, sys.B, sys.C, sys.D))
+    if A.shape[0] == 0 or not np.all(np.isfinite(A)):
+        return sys
+    T = state_balance(A, B, C)
+    return control.ss(A / T[:, None] * T[None, :], B / T[:, None], C * T[None, :], D)
 
 
 @dataclass(frozen=True)

@@ -27,6 +27,7 @@ from ..errors import DimensionError, InfeasibleError, LmiSuspensionError, Parame
 from ..lti.checks import as_finite_array
 from ..lti.norms import freqresp, hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
+from ..lti.scaling import balanced_statespace
 from .blocks import BlockStructure
 
 logger = logging.getLogger(__name__)
@@ -407,14 +408,14 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
             break
 
     mu_best, K, best_it = best
-    CL = lft(G, K)
+    CL = balanced_statespace(lft(G, K))
     dense = _dense_grid(omega, int(opts.n_dense), history[best_it - 1].peak_omega)
     final = _mu_bounds(CL, struct, dense, rng)
     reduced_from = None
     if opts.reduce_order is not None and int(opts.reduce_order) < K.nstates:
         K_red = _try_reduce(K, int(opts.reduce_order))
         if K_red is not None:
-            CL_red = lft(G, K_red)
+            CL_red = balanced_statespace(lft(G, K_red))
             if np.all(np.real(CL_red.poles()) < 0):
                 final_red = _mu_bounds(CL_red, struct, dense, rng)
                 if np.max(final_red.upper) <= np.max(final.upper) * (1 + opts.reduce_mu_tol):

@@ -13,7 +13,7 @@ from ..errors import (IllPosedLoopError, InfeasibleError, ParameterError,
 from ..lti.checks import as_statespace
 from ..lti.norms import hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
-from ..lti.scaling import PlantScaling, scale_plant, transform_states
+from ..lti.scaling import PlantScaling, balanced_statespace, scale_plant, transform_states
 from . import lmi as _lmi
 from .checks import check_riccati_assumptions, check_stabilizable
 from .result import HinfsynOptions, HinfsynResult, Timings
@@ -61,7 +61,8 @@ def _fastest_pole(K: control.StateSpace) -> float:
 
 def _certify(G: GeneralizedPlant, K, gamma_solver: float, opts: HinfsynOptions,
              warnings: list, what: str):
-    CL = lft(G, K)
+    # returned balanced, so that evaluating CL directly agrees with the certificate
+    CL = balanced_statespace(lft(G, K))
     gamma, _ = hinfnorm(CL)
     poles = np.linalg.eigvals(CL.A) if CL.nstates else np.zeros(0, dtype=complex)
     if not np.isfinite(gamma):
