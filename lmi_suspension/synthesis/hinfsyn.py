@@ -61,9 +61,10 @@ def _fastest_pole(K: control.StateSpace) -> float:
 
 def _certify(G: GeneralizedPlant, K, gamma_solver: float, opts: HinfsynOptions,
              warnings: list, what: str):
+    CL = lft(G, K)
+    gamma, _ = hinfnorm(CL)  # what a user's hinfnorm(lft(P, K)) gives, bit for bit
     # returned balanced, so that evaluating CL directly agrees with the certificate
-    CL = balanced_statespace(lft(G, K))
-    gamma, _ = hinfnorm(CL)
+    CL = balanced_statespace(CL)
     poles = np.linalg.eigvals(CL.A) if CL.nstates else np.zeros(0, dtype=complex)
     if not np.isfinite(gamma):
         warnings.append(f"{what}: the closed loop is NOT stable (max Re pole = "
