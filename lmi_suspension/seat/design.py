@@ -204,7 +204,7 @@ def design_nominal_hinf(design: SeatDesignOptions | None = None, *,
         ("riccati": python-control as users call it). "best" takes the LMI and, should
         its reconstruction fail, the balanced Riccati controller; either way γ is the
         certified closed-loop norm.  The controller is near-optimal for the nominal
-        plant (within the LMI's 0.3 % relaxation), as a designer who ignores the delay
+        plant (within 0.1–0.3 % of the LMI optimum), as a designer who ignores the delay
         would have it; such a controller loses stability at a few milliseconds of delay
         (measured 2026-11-23: 1.7 ms; with the previous weights 2.5 ms, against 206 ms
         for a 5 % relaxed one).
