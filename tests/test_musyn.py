@@ -137,6 +137,31 @@ def test_singular_k_step_needs_the_lmi():
     assert again.upper == pytest.approx(res.mu_peak, rel=1e-3)
 
 
+def test_dfit_failure_ends_the_loop_with_the_best_iterate(monkeypatch):
+    """A D-fit whose scaled plant is unusable (``scaled_plant`` raises SolverError, seen on
+    the distillation plant with its poles moved) must not crash a D-K run: the loop stops
+    and returns the best controller so far, with the reason."""
+    from lmi_suspension.errors import SolverError
+    from lmi_suspension.mu import dfit
+
+    calls = []
+
+    def failing(*args, **kwargs):
+        calls.append(1)
+        raise SolverError("the scaled plant has more unstable modes than the plant")
+
+    monkeypatch.setattr(dfit, "scaled_plant", failing)
+    P = singular_plant()
+    res = musyn(P, 1, 1, [[1, 1], [1, 1]], omega=np.logspace(-3, 3, 40),
+                options=MusynOptions(max_iter=3, method="lmi"))
+    assert calls == [1] and len(res.history) == 1
+    assert "D-fit failed after iteration 1" in res.stop_reason
+    assert res.history[0].K is not None
+    # the returned controller is iteration 1's, re-checked on the true plant
+    np.testing.assert_array_equal(res.K.A, res.history[0].K.A)
+    assert np.all(res.CL.poles().real < 0)
+
+
 def test_blk_must_fit_the_plant():
     ex = skogestad_distillation()
     with pytest.raises(DimensionError, match="block structure"):

@@ -138,6 +138,8 @@ class MusynIteration:
         Wall time of the K-step, the D-step and the D-fit.
     warnings : tuple of str
         Warnings of the K-step (recoveries, certificate disagreements).
+    K : control.StateSpace or None
+        This iteration's controller.
     """
 
     index: int
@@ -152,6 +154,7 @@ class MusynIteration:
     seconds_fit: float
     warnings: tuple = ()
     gamma_prev: float = float("nan")
+    K: control.StateSpace | None = field(default=None, repr=False, compare=False)
 
 
 @dataclass(frozen=True)
@@ -181,6 +184,8 @@ class MusynResult:
         Order before a successful order reduction, else ``None``.
     seconds : float
         Total wall time.
+    omega : numpy.ndarray
+        The design grid, rad/s.
     """
 
     K: control.StateSpace
@@ -381,19 +386,24 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
         if done is None:
             # Emphasise the frequencies that set the peak: the fit matters most there.
             weights = 0.2 + upper / mu_peak
-            dfit = fit_dscales(omega, mu.d_blocks, max_order=opts.max_dfit_order,
-                               rtol=opts.dfit_rtol, weights=weights,
-                               mu_check=lambda fits: _scaled_peak(fits, M, omega, dk_struct),
-                               mu_peak=mu_peak)
-            orders = tuple(max(o) for o in dfit.orders)
-            PD = scaled_plant(G.sys, nmeas, ncon, dfit, _block_sizes(dk_struct))
+            try:
+                dfit = fit_dscales(omega, mu.d_blocks, max_order=opts.max_dfit_order,
+                                   rtol=opts.dfit_rtol, weights=weights,
+                                   mu_check=lambda fits: _scaled_peak(fits, M, omega, dk_struct),
+                                   mu_peak=mu_peak)
+                orders = tuple(max(o) for o in dfit.orders)
+                PD = scaled_plant(G.sys, nmeas, ncon, dfit, _block_sizes(dk_struct))
+            except LmiSuspensionError as exc:
+                # no usable scaled plant for the next K-step: end with the best iterate
+                done = f"D-fit failed after iteration {it}: {exc}"
+                logger.warning("musyn: %s; keeping iteration %d", done, best[2])
         t4 = time.perf_counter()
         record = MusynIteration(
             index=it, gamma=float(syn.gamma), mu_peak=mu_peak,
             mu_lower_peak=float(np.max(lower)), peak_omega=float(omega[k_peak]),
             dfit_orders=orders, controller_order=K.nstates, seconds_k=t1 - t0,
             seconds_d=t2 - t1, seconds_fit=t4 - t3, warnings=tuple(syn.warnings),
-            gamma_prev=gamma_prev)
+            gamma_prev=gamma_prev, K=K)
         history.append(record)
         K_prev = K
         logger.info("musyn iteration %d: gamma=%.4f (previous K %.4f) mu=%.4f (lower %.4f) "
