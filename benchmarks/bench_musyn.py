@@ -21,7 +21,8 @@ def test_bench_musyn_distillation(benchmark, method):
     ex = skogestad_distillation()
     res = benchmark.pedantic(
         musyn, args=(ex.P, ex.nmeas, ex.ncon, ex.blk),
-        kwargs=dict(omega=OMEGA, options=MusynOptions(max_iter=6, patience=3, method=method)),
+        kwargs=dict(omega=OMEGA, options=MusynOptions(max_iter=10, patience=3,
+                                                      min_improvement=1e-3, method=method)),
         rounds=1, iterations=1)
     benchmark.extra_info["mu_per_iteration"] = [h.mu_peak for h in res.history]
     benchmark.extra_info["gamma_per_iteration"] = [h.gamma for h in res.history]
@@ -29,6 +30,7 @@ def test_bench_musyn_distillation(benchmark, method):
     benchmark.extra_info["mu_lower_peak_dense"] = res.mu_lower_peak
     benchmark.extra_info["gamma_prev_per_iteration"] = [h.gamma_prev for h in res.history]
     benchmark.extra_info["stop_reason"] = res.stop_reason
+    benchmark.extra_info["seconds_k_per_iteration"] = [h.seconds_k for h in res.history]
     assert res.mu_lower_peak <= res.mu_peak
 
 

@@ -66,6 +66,15 @@ class HinfsynOptions:
         ``(1 + r) γ`` for each ``r`` here are also computed and certified, and the
         lowest certified one is returned.  Empty by default (the plain baseline);
         :func:`~lmi_suspension.mu.musyn` turns it on for its K-steps.
+    riccati_search : {"python-control", "bisection"}
+        ``method="riccati"`` with ``gamma=None`` only: ``"python-control"`` (default, the
+        baseline as users call it) takes python-control's γ-optimal ``hinfsyn``;
+        ``"bisection"`` searches γ over SLICOT's suboptimal controllers (``sb10ad`` job 4),
+        each certified, down to a bracket ``riccati_rtol`` wide, and returns the lowest
+        certified one (faster, and it avoids the ill-conditioned optimum; used by
+        :func:`~lmi_suspension.mu.musyn`).
+    riccati_rtol : float
+        Relative width at which the ``"bisection"`` search stops.
     gamma_abort : float or None
         ``method="lmi"`` only: raise :class:`~lmi_suspension.errors.SolverError` as soon as
         the γ minimisation's optimum exceeds this level (a γ another controller is
@@ -105,6 +114,8 @@ class HinfsynOptions:
     cert_rtol: float = 5e-3
     riccati_scale: bool = False
     riccati_probes: tuple = ()
+    riccati_search: str = "python-control"
+    riccati_rtol: float = 1e-3
     gamma_abort: float | None = None
     tighten_rtol: float = 1e-3
     polish_steps: int = 4
@@ -115,11 +126,14 @@ class HinfsynOptions:
         if self.gamma is not None and not (np.isfinite(self.gamma) and self.gamma > 0):
             raise ParameterError(f"gamma must be positive and finite, got {self.gamma!r}")
         for name in ("polish_step", "gamma_relax", "gamma_atol", "tol_gap_abs", "tol_gap_rel", "tol_feas", "margin",
-                     "xy_bound", "center_trace", "cert_rtol", "reduced_tol_gap_abs",
+                     "xy_bound", "center_trace", "cert_rtol", "reduced_tol_gap_abs", "riccati_rtol",
                      "reduced_tol_gap_rel", "reduced_tol_feas"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
                 raise ParameterError(f"{name} must be positive and finite, got {v!r}")
+        if self.riccati_search not in ("python-control", "bisection"):
+            raise ParameterError("riccati_search must be 'python-control' or 'bisection', "
+                                 f"got {self.riccati_search!r}")
         if self.direct_solve_method not in ("faer", "qdldl"):
             raise ParameterError("direct_solve_method must be 'faer' or 'qdldl', got "
                                  f"{self.direct_solve_method!r}")
