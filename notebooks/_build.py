@@ -505,7 +505,7 @@ by Monte-Carlo simulation instead.
 
 µ is recomputed here from the controller alone and compared with the bounds stored by the
 design (two routes to the same number). With the bump-shaped design disturbance the peak
-is below 1 (measured 0.88, upper = lower bound); the simulations below check the delay
+is below 1 (measured 0.854, upper = lower bound); the simulations below check the delay
 part of the set directly, with the exact delay.
 """),
     code(r"""
