@@ -301,8 +301,9 @@ plt.show()
     md(r"""
 ## D-K iteration
 
-`musyn` alternates a K-step (H∞ synthesis on the D-scaled plant; `method="best"` runs both
-LMI and Riccati and keeps the one with the lower certified γ), a D-step (`mussv` on the
+`musyn` alternates a K-step (H∞ synthesis on the D-scaled plant; `method="best"` runs a
+certified Riccati γ search, and the LMI where Riccati fails or does not beat the previous
+controller, and keeps the lowest certified γ), a D-step (`mussv` on the
 design grid) and a D-fit (stable, minimum-phase rational scalings). Two iterations on a
 30-point grid with D-fits of order ≤ 2 keep this cell short; the table is the iteration
 history. `gamma` is the certified H∞ norm of the scaled closed loop, an upper bound of µ at

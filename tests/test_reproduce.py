@@ -127,6 +127,7 @@ def test_summary_has_every_controller_and_delay(run):
                 row["bump"]["peak_z3dd"] / limit, rel=1e-12)
     assert len(data["mu"]["history"]) == len(run.history)
     assert data["mu"]["history"][1]["mu_peak"] == run.history[1].mu_peak
+    assert data["mu"]["history"][1]["K"] is None  # controllers stay out of the summary
     assert data["mu"]["peak_upper"] == pytest.approx(max(data["mu"]["upper"]))
     assert data["timings"]["total"] > 0
     assert data["monte_carlo"]["n"] == len(data["monte_carlo"]["peak_z3dd"])

@@ -489,7 +489,9 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     }
     files.append(save_controller(out / "controller.json", mu_design.K, inputs=["x1", "x3"],
                                  outputs=["u"], metadata=metadata))
-    history = getattr(getattr(mu_design, "musyn", None), "history", ())
+    # per-iteration diagnostics without the controllers (the returned one is controller.json)
+    history = [dataclasses.replace(h, K=None)
+               for h in getattr(getattr(mu_design, "musyn", None), "history", ())]
     total = time.perf_counter() - t_start
     timings["total"] = total
     data = {
