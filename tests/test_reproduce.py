@@ -17,7 +17,7 @@ from matplotlib.image import imread
 from lmi_suspension.errors import AssumptionError, ParameterError
 from lmi_suspension.io import load_controller
 from lmi_suspension.mu.dk import MusynIteration
-from lmi_suspension.seat.design import SeatMuDesign
+from lmi_suspension.seat.design import MuCheck, SeatMuDesign
 from lmi_suspension.seat import (
     SeatDesignOptions,
     bump,
@@ -64,8 +64,14 @@ def _stand_in(fail_riccati=False):
         gain = 10000.0 if method == "lmi" else 25000.0
         return control.ss([[-300.0]], [[300.0, 0.0]], [[gain]], [[0.0, 0.0]])
 
+    def analyse_uncertainty(K, design=None, *, params=None, omega=None, rng=None):
+        calls.append("analysis")
+        return (MuCheck("as designed", ("delay", "performance"), 0.7, 0.69, 12.0),
+                MuCheck("+ paper", ("delay", "nb_AB", "performance"), 0.8, 0.79, 13.0))
+
     api = SimpleNamespace(design_mu_controller=design_mu_controller,
                           design_nominal_hinf=design_nominal_hinf,
+                          analyse_uncertainty=analyse_uncertainty,
                           DEFAULT_DESIGN=SeatDesignOptions(), DEFAULT_MUSYN=None)
     return api, K_mu, history, calls
 
@@ -128,6 +134,9 @@ def test_summary_has_every_controller_and_delay(run):
     assert len(data["mu"]["history"]) == len(run.history)
     assert data["mu"]["history"][1]["mu_peak"] == run.history[1].mu_peak
     assert data["mu"]["history"][1]["K"] is None  # controllers stay out of the summary
+    # the extended-structure µ analysis is passed through as computed
+    assert [c["structure"] for c in data["mu"]["analysis"]] == ["as designed", "+ paper"]
+    assert data["mu"]["analysis"][1]["mu_peak"] == 0.8
     assert data["mu"]["peak_upper"] == pytest.approx(max(data["mu"]["upper"]))
     assert data["timings"]["total"] > 0
     assert data["monte_carlo"]["n"] == len(data["monte_carlo"]["peak_z3dd"])

@@ -96,6 +96,10 @@ class SeatDesignOptions:
         real ones) instead of real ``[-1, 0]`` rows.
     paper_delta : float
         δ of the paper's norm-bounded uncertainty (0.02).
+    paper_input_uncertainty : bool
+        Keep ``ΔB`` in the paper's A/B block (``E_B``, printed empty in the paper and
+        reconstructed as ``δ [0 1 0 0 0 0]ᵀ`` per newton, see
+        :func:`~.uncertainty.paper_norm_bounded`); ``False`` takes ``E_B = 0``.
 
     Examples
     --------
@@ -130,6 +134,7 @@ class SeatDesignOptions:
     damping_rel: float = 0.2
     parametric_complex: bool = False
     paper_delta: float = 0.02
+    paper_input_uncertainty: bool = True
 
     def __post_init__(self):
         def num(name, value, *, positive=True, allow_none=False):
@@ -165,7 +170,7 @@ class SeatDesignOptions:
             num(f"noise[{i}]", v)
         object.__setattr__(self, "noise", tuple(float(v) for v in noise))
         for name in ("include_delay", "include_parametric", "include_paper",
-                     "parametric_complex"):
+                     "parametric_complex", "paper_input_uncertainty"):
             if not isinstance(getattr(self, name), bool):
                 raise ParameterError(f"{name} must be True or False")
         if self.wk_order not in (2, 3, 4) or isinstance(self.wk_order, bool):
@@ -325,7 +330,8 @@ def _core(params: SeatParameters, opts: SeatDesignOptions):
                 extra_B.append(left)  # enters the state equation
                 extra_Dzp.append(np.zeros((4, r)))
                 extra_C.append(right[:, :6])
-                extra_Dqu.append(right[:, 6:])
+                extra_Dqu.append(right[:, 6:] if opts.paper_input_uncertainty
+                                 else np.zeros_like(right[:, 6:]))
             else:
                 extra_B.append(np.zeros((6, r)))
                 Dz = np.zeros((4, r))
