@@ -1,11 +1,12 @@
 """The robust µ design of the seat suspension (and its nominal H∞ comparison controller).
 
 :func:`design_mu_controller` runs D-K iteration (:func:`~lmi_suspension.mu.musyn`) on the
-augmented plant of Fig. 2 (:func:`~lmi_suspension.seat.augmented.seat_augmented_plant`)
-with the delay cover (0–25 ms), the occupant-mass / stiffness uncertainty and the paper's
-norm-bounded blocks, and re-evaluates µ of the returned controller on a dense grid.
-:func:`design_nominal_hinf` is the comparison controller: H∞ on the same performance
-weights with an ideal actuator and no uncertainty.
+augmented plant of Fig. 2 (:func:`~lmi_suspension.seat.augmented.seat_augmented_plant`;
+by default with the delay cover, 0–25 ms, as its uncertainty) and re-evaluates µ of the
+returned controller on a dense grid.  :func:`analyse_uncertainty` computes that
+controller's µ with the paper's norm-bounded blocks added.  :func:`design_nominal_hinf`
+is the comparison controller: H∞ on the same performance weights with an ideal actuator
+and no uncertainty.
 
 Status of the tuning (measured 2026-11-23, see tests/test_design.py and the notes of
 issue 6): the default design certifies robust performance, µ = 0.854 < 1 (upper = lower
@@ -26,7 +27,7 @@ without them) and D-K ends at µ 2.20 with a controller that uses ≤ 634 N on t
 (peaks 23–25 m/s²); even with that channel scaled like the delay channel D-K ends at
 µ 1.008. Through L1 (rows 2, 4, 6) that E_B lets up to 3 % of the actuator force act on
 the upper body directly, a path the actuator does not have, and the default controller
-gives µ 3.18 on it. With E_B = 0 (printed empty in the paper) the default controller
+gives µ 3.20 on it. With E_B = 0 (printed empty in the paper) the default controller
 certifies µ = 0.901 (upper = lower bound) on the structure with all paper blocks, but
 synthesising on that structure leads D-K to a controller with a 10.6 m/s² peak at
 25 ms. Occupant-mass and stiffness variation is checked instead by Monte-Carlo
@@ -56,10 +57,9 @@ logger = logging.getLogger(__name__)
 #: follows the velocity spectrum ``|Ẑ0(jω)|`` of eq. (32) over 1–30 rad/s and falls off
 #: with it above its main lobe (≈ 45 rad/s), where a flat design disturbance made µ peak
 #: (65 rad/s) in a band in which the 25 ms delay forbids control and the bump has no
-#: energy. Measured 2026-11-23 (seed 0, 2-core machine at load ≈ 2 from other jobs,
-#: 10.6–11.4 s; the previous default took 8.5 s there): certified µ = 0.854 (upper =
-#: lower bound) over the delay cover; bump peak z̈3
-#: 9.07 / 8.43 / 7.87 / 7.35 / 7.79 / 9.02 m/s² at 0 / 5 / … / 25 ms, i.e. 1.47 / 1.37 /
+#: energy. Measured 2026-11-23 (seed 0, idle 2-core machine, ≈ 3 s with the bisection
+#: Riccati K-step): certified µ = 0.854 (upper = lower bound) over the delay cover; bump
+#: peak z̈3 9.06 / 8.42 / 7.87 / 7.34 / 7.79 / 9.03 m/s² at 0 / 5 / … / 25 ms, i.e. 1.47 / 1.37 /
 #: 1.28 / 1.19 / 1.26 / 1.46 × the physical limit 6.164 (at most 1.471 on a 2.5 ms grid
 #: over 0–25 ms; was 1.25–1.60 with acc_ref 3, u_max 3000, z_max 0.10, noise 0.5 mm,
 #: w_corner 13.5, w_rolloff 45, delay_order 2: 9.86 m/s² at 0 ms, 9.71 at 25 ms); peak
@@ -108,12 +108,14 @@ DEFAULT_DESIGN = SeatDesignOptions(
     parametric_complex=True,
 )
 
-#: D-K settings: each K-step runs the Riccati route on the plant as given and balanced
-#: (with suboptimal probes) and the LMI route, and keeps the lowest certified γ; constant
-#: D-scales (measured 2026-11-23: order-1 fits ended at µ 1.05–1.11 instead of 0.94–0.98,
-#: and with order-2 fits the second K-step ran > 80 s); four iterations (µ 4.275, 1.447,
-#: 0.984, 0.851 on the design grid; 0.854 on the dense one) take 10.6–11.4 s on the
-#: 2-core machine at load ≈ 2 from other jobs (≈ 15–25 s at load 3–5).
+#: D-K settings: each K-step runs the certified Riccati γ search (plant as given and
+#: balanced) and, on the first iteration or when Riccati does not beat the previous
+#: controller, the LMI route, and keeps the lowest certified γ; constant D-scales
+#: (measured 2026-11-23: order-1 fits ended at µ 1.05–1.11 instead of 0.94–0.98, and with
+#: order-2 fits the second K-step ran > 80 s); four iterations (µ 4.277, 1.447, 0.984,
+#: 0.851 on the design grid; 0.854 on the dense one) take ≈ 3 s on the idle 2-core
+#: machine.  With method="lmi" alone: µ 0.827 in 46 s, but a bump peak of 10.2 m/s² at
+#: 25 ms (1.66 × the limit); with "riccati" alone: the same controller as "best" in 1.5 s.
 #: A fifth iteration is not taken: it lowers µ to 0.811 but raises the bump peaks to
 #: 9.15 / 9.22 m/s² at 0 / 25 ms and the design time to ≈ 30 s (measured).
 DEFAULT_MUSYN = MusynOptions(method="best", max_iter=4, patience=1, max_dfit_order=0,
