@@ -35,7 +35,7 @@ import scipy.optimize
 
 from ..errors import IterationLimitError, ParameterError
 from .checks import as_statespace
-from .scaling import state_balance
+from .scaling import balanced_matrices
 
 __all__ = ["hinfnorm", "h2norm", "sigma_max", "freqresp", "is_stable"]
 
@@ -58,8 +58,7 @@ def _matrices(sys):
     if n == 0 or not (np.all(np.isfinite(A)) and np.all(np.isfinite(B))
                       and np.all(np.isfinite(C))):
         return A, B, C, D
-    t = state_balance(A, B, C)
-    return A / t[:, None] * t[None, :], B / t[:, None], C * t[None, :], D
+    return (*balanced_matrices(A, B, C), D)
 
 
 def is_stable(sys, *, tol: float = STABILITY_TOL) -> bool:

@@ -25,8 +25,8 @@ from ..errors import DimensionError
 from .checks import as_statespace
 from .plant import GeneralizedPlant
 
-__all__ = ["PlantScaling", "balanced_statespace", "scale_plant", "state_balance",
-           "transform_states"]
+__all__ = ["PlantScaling", "balanced_matrices", "balanced_statespace", "scale_plant",
+           "state_balance", "transform_states"]
 
 
 def _pow2(x):
@@ -77,10 +77,15 @@ def balanced_statespace(sys: control.StateSpace) -> control.StateSpace:
     True
     """
     A, B, C, D = (np.asarray(M, dtype=float) for M in (sys.A, sys.B, sys.C, sys.D))
-    if A.shape[0] == 0 or not np.all(np.isfinite(A)):
+    if A.shape[0] == 0 or not all(np.all(np.isfinite(M)) for M in (A, B, C)):
         return sys
+    return control.ss(*balanced_matrices(A, B, C), D)
+
+
+def balanced_matrices(A, B, C):
+    """``T⁻¹AT``, ``T⁻¹B``, ``CT`` with ``T`` from :func:`state_balance` (finite data)."""
     T = state_balance(A, B, C)
-    return control.ss(A / T[:, None] * T[None, :], B / T[:, None], C * T[None, :], D)
+    return A / T[:, None] * T[None, :], B / T[:, None], C * T[None, :]
 
 
 @dataclass(frozen=True)

@@ -223,12 +223,13 @@ def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warni
 
     A level counts as achieved when ``sb10ad`` returns a stabilising controller (judging
     it by its certified norm instead, which near the optimum may exceed the level, made
-    the search stop 0.5 % higher on a D-scaled distillation plant); the bracket is found by factors of 4 from γ = 1 and then halved
-    geometrically until it is ``riccati_rtol`` wide.  Returns the controller with the
-    lowest certified γ met on the way and the lowest achieved level.  python-control's
-    ``hinfsyn`` (``sb10ad`` job 3: bisection, then a scan down from its result) took
-    15 s on a 6-state D-scaled distillation plant where this takes well under a second,
-    and its γ-optimal controllers are the ill-conditioned ones.
+    the search stop 0.5 % higher on a D-scaled distillation plant).  The bracket is
+    found by factors of 4 from γ = 1 and then halved geometrically until it is
+    ``riccati_rtol`` wide.  Returns the controller with the lowest certified γ met on
+    the way and the lowest achieved level.  python-control's ``hinfsyn`` (``sb10ad``
+    job 3: bisection, then a scan down from its result) took 15 s on the 6-state
+    distillation plant where this takes well under a second, and its γ-optimal
+    controllers are the ill-conditioned ones.
     """
     best = None  # (certified gamma, K)
 
@@ -279,8 +280,9 @@ def _probe(G: GeneralizedPlant, sc: PlantScaling, used: tuple, g_try: float,
            opts: HinfsynOptions):
     """Re-solve the (already compiled) controller LMI at ``g_try`` and certify.
 
-    Returns ``(result tuple or None, description)``; ``None`` when the solve fails or
-    the closed loop is unstable."""
+    Returns ``(result tuple or None, description, warnings)``; ``None`` when the solve
+    fails or the closed loop is unstable; ``warnings`` are the solve's and the
+    certificate's, for the caller to keep when it keeps the result."""
     lmi_k, trace_bound = used
     tc = time.perf_counter()
     probe_warn: list[str] = []
@@ -290,11 +292,11 @@ def _probe(G: GeneralizedPlant, sc: PlantScaling, used: tuple, g_try: float,
         K = _undo_loop_shift(sc.controller_to_original(Ks), G.D22)
         CL, gamma, poles = _certify(G, K, g_try, opts, probe_warn, "lmi")
     except (InfeasibleError, SolverError, np.linalg.LinAlgError) as exc:
-        return None, str(exc)
+        return None, str(exc), []
     if not np.isfinite(gamma):
-        return None, "; ".join(probe_warn)
+        return None, "; ".join(probe_warn), []
     return ((K, CL, gamma, poles, g_try, status, cond_xy, float("nan"),
-             time.perf_counter() - tc), f"certified {gamma:.6g}")
+             time.perf_counter() - tc), f"certified {gamma:.6g}", list(cwarn) + probe_warn)
 
 
 def _polish(G: GeneralizedPlant, sc: PlantScaling, used: tuple, result: tuple,
@@ -312,13 +314,14 @@ def _polish(G: GeneralizedPlant, sc: PlantScaling, used: tuple, result: tuple,
     for k in range(int(opts.polish_steps)):
         best = result[2]
         g_try = best * (1.0 - step)
-        probe, why = _probe(G, sc, used, g_try, opts)
+        probe, why, probe_warn = _probe(G, sc, used, g_try, opts)
         if probe is None or not probe[2] < best:
             # below the infimum, or too close to it for the solver: halve the step
             warnings.append(f"polish probe {k + 1} at gamma={g_try:.6g}: {why}")
             step /= 2.0
             continue
         warnings.append(f"polish probe {k + 1}: certified {probe[2]:.6g} (was {best:.6g})")
+        warnings += probe_warn
         result = probe
     return result
 
@@ -332,10 +335,11 @@ def _tighten(G: GeneralizedPlant, sc: PlantScaling, used: tuple, result: tuple,
     lmi_k, trace_bound = used
     for factor in (10.0, 1000.0):
         # nearer the optimum X and Y grow: widen the trace box that bounds them
-        probe, why = _probe(G, sc, (lmi_k, trace_bound * factor), g_try, opts)
+        probe, why, probe_warn = _probe(G, sc, (lmi_k, trace_bound * factor), g_try, opts)
         if probe is not None and probe[2] < result[2]:
             warnings.append(f"tightened: certified {probe[2]:.6g} at gamma={g_try:.6g} "
                             f"(was {result[2]:.6g})")
+            warnings.extend(probe_warn)
             return probe
     warnings.append(f"tightening at gamma={g_try:.6g} kept the first controller: {why}")
     return result

@@ -60,8 +60,8 @@ class HinfsynOptions:
         python-control sees it. Off by default so that the baseline is python-control
         exactly as users call it.
     riccati_probes : tuple of float
-        ``method="riccati"`` with ``gamma=None`` only: when python-control's controller
-        certifies more than ``cert_rtol`` above its own γ (its formulas are
+        ``method="riccati"`` with ``gamma=None`` only: when the Riccati controller
+        certifies more than ``cert_rtol`` above its own γ (the formulas are
         ill-conditioned at the optimum), the suboptimal controllers at
         ``(1 + r) γ`` for each ``r`` here are also computed and certified, and the
         lowest certified one is returned.  Empty by default (the plain baseline);
