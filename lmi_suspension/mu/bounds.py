@@ -687,6 +687,112 @@ def _power_lower(M, struct, rng, starts, opts, target=np.inf):
     return best
 
 
+def _power_lower_full_batch(stack, struct, rng, opts, DL, DR, upper):
+    """The power iteration of :func:`_power_lower` for full complex blocks, run on all
+    frequencies of ``stack`` (``n_out × n_in × n_freq``) at once.
+
+    The per-frequency loop spent up to 14 ms per frequency here: 7.4 s of a 528-point
+    certification of a 22-state distillation loop (profiled).  One batched step costs
+    about as much as one step at a single frequency.  Starts, in this order, each only
+    at the frequencies whose bound is still below ``upper`` (``1e-9`` relative):
+
+    * the upper bound's own scaled singular vectors: with ``u`` the top left singular
+      vector of ``D_L M D_R⁻¹``, ``a = D_L⁻¹ u`` and ``w = D_L u`` is a fixed point of the
+      iteration whenever the upper bound is tight (as it is for up to three full blocks);
+    * the best pairs of the two neighbouring frequencies (the sequential warm start);
+    * ``opts.power_restarts`` random pairs.
+
+    Every candidate Δ is checked like the sequential one (``det(I - M Δ) ≈ 0``).
+    ``DL``, ``DR`` are the upper bound's scalings (``n_out × n_out × n_freq`` and
+    ``n_in × n_in × n_freq``) and ``upper`` its values.  Returns
+    ``(lower, delta)``: shapes ``(n_freq,)`` and ``(n_freq, n_in, n_out)``.
+    """
+    nout, nin, nf = stack.shape
+    M = np.ascontiguousarray(np.moveaxis(stack, -1, 0))  # nf x nout x nin
+    MH = np.conj(np.swapaxes(M, 1, 2))
+    rl, cl = _block_labels(struct)
+    m = struct.n_blocks
+    Er = (rl[:, None] == np.arange(m)[None, :]).astype(float)  # nout x m
+    Ec = (cl[:, None] == np.arange(m)[None, :]).astype(float)  # nin x m
+    mask = cl[:, None] == rl[None, :]  # nin x nout: the block diagonal of Δ
+
+    def iterate(idx, a, w):
+        a = a / np.maximum(np.linalg.norm(a, axis=1, keepdims=True), 1e-300)
+        w = w / np.maximum(np.linalg.norm(w, axis=1, keepdims=True), 1e-300)
+        prev = np.full(idx.size, -1.0)
+        act = np.arange(idx.size)
+        for _ in range(opts.power_maxiter):
+            Mi, a_i = M[idx[act]], a[act]
+            z = np.einsum("fij,fj->fi", MH[idx[act]], w[act])
+            na = np.sqrt(np.abs(a_i) ** 2 @ Er)
+            nz = np.sqrt(np.abs(z) ** 2 @ Ec)
+            ok = (na > 0) & (nz > 0)
+            ratio = np.where(ok, na / np.where(ok, nz, 1.0), 0.0)
+            inv = np.where(ok, 1.0 / np.where(ok, ratio, 1.0), 0.0)
+            an = np.einsum("fij,fj->fi", Mi, (ratio @ Ec.T) * z)
+            wn = (inv @ Er.T) * a_i
+            n_a, n_w = np.linalg.norm(an, axis=1), np.linalg.norm(wn, axis=1)
+            alive = (n_a > 0) & (n_w > 0)
+            a[act[alive]] = an[alive] / n_a[alive, None]
+            w[act[alive]] = wn[alive] / n_w[alive, None]
+            done = ~alive | (np.abs(n_a - prev[act]) <= opts.power_tol * n_a)
+            prev[act] = n_a
+            act = act[~done]
+            if not act.size:
+                break
+        return a, w
+
+    def candidates(idx, a, w):
+        Mi = M[idx]
+        z = np.einsum("fij,fj->fi", MH[idx], w)
+        na = np.sqrt(np.abs(a) ** 2 @ Er)[:, rl]
+        nz = np.sqrt(np.abs(z) ** 2 @ Ec)[:, cl]
+        ok = np.all(na > 0, axis=1) & np.all(nz > 0, axis=1)
+        Q = ((z / np.where(nz > 0, nz, 1.0))[:, :, None]
+             * np.conj(a / np.where(na > 0, na, 1.0))[:, None, :])
+        Q = np.where(mask[None], Q, 0.0)
+        lam = np.linalg.eigvals(Mi @ Q)
+        lk = lam[np.arange(idx.size), np.argmax(np.abs(lam), axis=1)]
+        ok &= np.abs(lk) > 0
+        Delta = Q / np.where(ok, lk, 1.0)[:, None, None]
+        nrm = np.linalg.norm(Delta, 2, axis=(1, 2))
+        MD = Mi @ Delta
+        smin = np.linalg.svd(np.eye(nout)[None] - MD, compute_uv=False)[:, -1]
+        ok &= np.isfinite(nrm) & (nrm > 0)
+        ok &= smin <= opts.det_tol * (1.0 + np.linalg.norm(MD, 2, axis=(1, 2)))
+        return np.where(ok, 1.0 / np.where(ok, nrm, 1.0), 0.0), Delta
+
+    best = np.zeros(nf)
+    best_delta = np.zeros((nf, nin, nout), dtype=complex)
+    best_a = np.zeros((nf, nout), dtype=complex)
+    best_w = np.zeros((nf, nout), dtype=complex)
+    short = np.asarray(upper) * (1 - 1e-9)
+
+    def run(a, w):
+        idx = np.flatnonzero(best < short)
+        if not idx.size:
+            return
+        ai, wi = iterate(idx, a[idx].copy(), w[idx].copy())
+        val, Delta = candidates(idx, ai, wi)
+        better = val > best[idx]
+        k = idx[better]
+        best[k], best_delta[k] = val[better], Delta[better]
+        best_a[k], best_w[k] = ai[better], wi[better]
+
+    DLs, DRs = np.moveaxis(DL, -1, 0), np.moveaxis(DR, -1, 0)
+    # D_L M D_R^-1, with M D_R^-1 = (D_R^-T M^T)^T
+    scaled = DLs @ np.swapaxes(np.linalg.solve(np.swapaxes(DRs, 1, 2), np.swapaxes(M, 1, 2)), 1, 2)
+    u = np.linalg.svd(scaled)[0][:, :, 0]
+    run(np.linalg.solve(DLs, u[:, :, None])[:, :, 0], np.einsum("fij,fj->fi", DLs, u))
+    if nf > 1:
+        for shift in (1, -1):
+            run(np.roll(best_a, shift, axis=0), np.roll(best_w, shift, axis=0))
+    for _ in range(opts.power_restarts):
+        run(rng.standard_normal((nf, nout)) + 1j * rng.standard_normal((nf, nout)),
+            rng.standard_normal((nf, nout)) + 1j * rng.standard_normal((nf, nout)))
+    return best, best_delta
+
+
 def _single_real_block_lower(M, opts):
     """µ of a lone repeated real scalar: the largest |real eigenvalue| of M."""
     lam = np.linalg.eigvals(M)
@@ -792,6 +898,9 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
     lmi = None
     x_prev, H_prev = None, None
     starts_prev = []
+    # full blocks with the fast upper bound: the lower bound runs afterwards on all
+    # frequencies at once, started from the upper bound's scalings
+    batch = opts.compute_lower and use == "fast"
     full_idx = [i for i, b in enumerate(struct.blocks) if b.kind is BlockKind.FULL]
     ref = full_idx[-1] if full_idx else m - 1
     lone_real = m == 1 and struct.blocks[0].is_real
@@ -816,7 +925,9 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
         # ---------------- lower bound (it also brackets the LMI iteration)
         t0 = time.perf_counter()
         target = ub_fast if ub_fast is not None else np.inf
-        if opts.compute_lower:
+        if batch:
+            lo_val, lo_delta, vecs = 0.0, None, None
+        elif opts.compute_lower:
             lo_val, lo_delta, vecs = _power_lower(Mk, struct, rng, starts_prev, opts, target)
         else:
             lo_val, lo_delta, vecs = 0.0, None, None
@@ -873,6 +984,17 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
         upper[k], lower[k] = ub, lo_val
         if lo_delta is not None:
             delta[:, :, k] = lo_delta
+
+    if batch:
+        t0 = time.perf_counter()
+        lower, dlt = _power_lower_full_batch(stack, struct, rng, opts, DL, DR, upper)
+        for k in np.flatnonzero(lower > upper * (1 + 1e-8)):
+            # equal bounds can cross by round-off; anything larger is a numerical problem
+            warnings.warn(f"mussv: lower bound {lower[k]:.10g} exceeds upper bound "
+                          f"{upper[k]:.10g} at index {k}; clipped", RuntimeWarning, stacklevel=2)
+        lower = np.minimum(lower, upper)
+        delta = np.moveaxis(dlt, 0, -1)
+        t_lo += time.perf_counter() - t0
 
     ipk = int(np.argmax(upper))
     peak = float(upper[ipk])

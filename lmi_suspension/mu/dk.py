@@ -130,8 +130,8 @@ class MusynIteration:
         Certified H∞ norm of the *previous* controller on this iteration's scaled plant
         (``nan`` on the first iteration): the level an exact K-step matches or beats.
     mu_peak, mu_lower_peak : float
-        Peak of the µ upper bound on the design grid, and the lower bound at the
-        frequency of that peak (a lower bound of the peak µ).
+        Peaks of the µ upper and lower bounds on the design grid (the lower one is a
+        lower bound of the peak µ).
     peak_omega : float
         Frequency of the upper-bound peak (rad/s).
     dfit_orders : tuple of int
@@ -244,24 +244,14 @@ def _block_sizes(struct: BlockStructure) -> list[tuple[int, int]]:
     return [(b.rows, b.cols) for b in struct.blocks]
 
 
-def _mu_bounds(CL, struct, omega, rng, M=None, *, lower_at_peak_only=False):
+def _mu_bounds(CL, struct, omega, rng, M=None):
     """µ bounds of ``CL`` over ``omega``; pass its frequency response ``M`` if known.
-
-    With ``lower_at_peak_only`` the lower bound (the power iteration, most of the cost)
-    is computed at the upper bound's peak frequency only: the D-step needs the upper
-    bound and its scalings everywhere, and one lower bound at the peak certifies how
-    tight the peak is.  Returns ``(result, lower_peak)``.
-    """
-    from .bounds import MussvOptions, mussv
+    Returns ``(result, lower_peak)``."""
+    from .bounds import mussv
 
     M = freqresp(CL, omega) if M is None else M
-    if not lower_at_peak_only:
-        mu = mussv(M, struct, omega=omega, rng=rng)
-        return mu, float(np.max(mu.lower))
-    mu = mussv(M, struct, omega=omega, rng=rng, options=MussvOptions(compute_lower=False))
-    k = int(np.argmax(mu.upper))
-    at_peak = mussv(M[:, :, k:k + 1], struct, omega=omega[k:k + 1], rng=rng)
-    return mu, float(np.max(at_peak.lower))
+    mu = mussv(M, struct, omega=omega, rng=rng)
+    return mu, float(np.max(mu.lower))
 
 
 def _scaled_peak(fits, M: np.ndarray, omega: np.ndarray, struct: BlockStructure) -> float:
@@ -389,7 +379,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
             stop_reason = f"K-step at iteration {it} returned a non-stabilising controller"
             break
         M = freqresp(CL, omega)  # one response for the D-step and the D-fit check
-        mu, lower_peak = _mu_bounds(CL, dk_struct, omega, rng, M, lower_at_peak_only=True)
+        mu, lower_peak = _mu_bounds(CL, dk_struct, omega, rng, M)
         t2 = time.perf_counter()
         upper = np.asarray(mu.upper)
         k_peak = int(np.argmax(upper))
