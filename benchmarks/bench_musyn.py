@@ -16,15 +16,21 @@ from lmi_suspension.mu import MusynOptions, musyn
 OMEGA = np.logspace(-3, 3, 61)  # the grid of dkpy's README example of this problem
 
 
-@pytest.mark.parametrize("method, max_iter",
-                         [("riccati", 10), ("lmi", 10), ("best", 10), ("best", 3)])
-def test_bench_musyn_distillation(benchmark, method, max_iter):
+@pytest.mark.parametrize("method, max_iter, extra", [
+    ("riccati", 10, {}), ("lmi", 10, {}), ("best", 10, {}), ("best", 3, {}),
+    # plain D-K steps, as before the over-relaxed D-step became the default
+    ("best", 10, {"dscale_overrelax": 1.0}),
+    # 4th-order fits at every iteration, as in the book's script
+    ("best", 12, {"dfit_rtol": 1e-3}),
+], ids=lambda v: "-".join(f"{k}={x}" for k, x in v.items()) if isinstance(v, dict) else None)
+def test_bench_musyn_distillation(benchmark, method, max_iter, extra):
     # three iterations match dkpy's configuration below (fit_orders=[4, 4, 4])
     ex = skogestad_distillation()
     res = benchmark.pedantic(
         musyn, args=(ex.P, ex.nmeas, ex.ncon, ex.blk),
         kwargs=dict(omega=OMEGA, options=MusynOptions(max_iter=max_iter, patience=3,
-                                                      min_improvement=1e-3, method=method)),
+                                                      min_improvement=1e-3, method=method,
+                                                      **extra)),
         rounds=1, iterations=1)
     benchmark.extra_info["mu_per_iteration"] = [h.mu_peak for h in res.history]
     benchmark.extra_info["gamma_per_iteration"] = [h.gamma for h in res.history]
