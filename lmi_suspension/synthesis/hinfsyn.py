@@ -284,12 +284,12 @@ def _probe(G: GeneralizedPlant, sc: PlantScaling, used: tuple, g_try: float,
     fails or the closed loop is unstable; ``warnings`` are the solve's and the
     certificate's, for the caller to keep when it keeps the result."""
     lmi_k, trace_bound = used
-    tc = time.perf_counter()
     probe_warn: list[str] = []
     try:
         Ks, cond_xy, status, cwarn = lmi_k.controller(g_try * sc.gamma_factor, trace_bound,
                                                       opts)
         K = _undo_loop_shift(sc.controller_to_original(Ks), G.D22)
+        tc = time.perf_counter()  # the certificate's own time (the solve is reconstruction)
         CL, gamma, poles = _certify(G, K, g_try, opts, probe_warn, "lmi")
     except (InfeasibleError, SolverError, np.linalg.LinAlgError) as exc:
         return None, str(exc), []
