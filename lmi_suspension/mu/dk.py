@@ -144,6 +144,8 @@ class MusynIteration:
     gamma_prev : float
         Certified H∞ norm of the *previous* controller on this iteration's scaled plant
         (``nan`` on the first iteration): the level an exact K-step matches or beats.
+        After a restart (``dscale_overrelax``) it is the best iterate's controller, the
+        one the scaled plant was built around.
     mu_peak, mu_lower_peak : float
         Peaks of the µ upper and lower bounds on the design grid (the lower one is a
         lower bound of the peak µ).
