@@ -270,6 +270,34 @@ def test_scaled_plant_keeps_a_slow_stable_pole_next_to_fast_fit_poles():
     assert np.min(np.abs(poles)) == pytest.approx(1e-6, rel=1e-6)
 
 
+def test_scaled_plant_falls_back_when_minreal_crosses_the_axis(monkeypatch):
+    """The series connection's poles are those of P, D and D^-1, all stable; when the
+    minimal realisation moves one across the axis (seen on a D-scaled distillation plant
+    with its -1e-6 rad/s weight pole: the D-K loop stopped on "more unstable modes"), the
+    connection is kept as it is.  Forced here by a minreal that returns a marginally
+    unstable system; the result must still equal D_L P D_R^-1 pointwise."""
+    from lmi_suspension.mu import dfit as dfit_module
+
+    rng = np.random.default_rng(12)
+    P = _random_plant(rng, 3, 2, 1, 2, 1)
+    dA = np.abs(control.tf([1, 3], [1, 0.5])(1j * W))
+    dfit = fit_dscales(W, [dA, np.ones_like(W)], rtol=1e-4)
+
+    def broken_minreal(sys, tol=None, verbose=False):
+        A = np.asarray(sys.A).copy()
+        A[0, 0] = A[0, 0] + 10.0 * np.abs(A).max()  # pushes a pole into the RHP
+        return control.ss(A, sys.B, sys.C, sys.D)
+
+    monkeypatch.setattr(dfit_module.control, "minreal", broken_minreal)
+    PD = scaled_plant(P, 1, 1, dfit, [(1, 1), (1, 1)])
+    assert np.all(np.linalg.eigvals(PD.A).real < 0)
+    wt = np.logspace(-2, 2, 9)
+    d = resp(dfit.fits[0], wt)[:, 0, 0]
+    expected = resp(P, wt) * np.array([d, np.ones_like(d), np.ones_like(d)]).T[:, :, None] \
+        / np.array([d, np.ones_like(d), np.ones_like(d)]).T[:, None, :]
+    np.testing.assert_allclose(resp(PD, wt), expected, rtol=1e-9)
+
+
 def test_fitted_scalings_certify_mu_of_zero_diagonal_system():
     """End-to-end: pointwise optimal D -> rational fit -> scaled plant -> peak bound.
 

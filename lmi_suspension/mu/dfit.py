@@ -722,8 +722,15 @@ def scaled_plant(P, nmeas: int, ncon: int, dfit: DScaleFit, block_sizes,
         if _n_unstable(S):
             raise SolverError(f"{label} is not stable; the D-scale fits must be stable and minimum phase")
     G0 = control.ss(G.A, G.B, G.C, G.D)  # drop signal names so the series product is plain
-    PD = control.series(DRinv, G0, DL)  # DL * G * DRinv
-    PD = control.minreal(PD, tol=minreal_tol, verbose=False)
+    series = control.series(DRinv, G0, DL)  # DL * G * DRinv
+    PD = control.minreal(series, tol=minreal_tol, verbose=False)
+    if _n_unstable(PD) > _n_unstable(G0):
+        # The series connection's poles are those of G, D and D^-1 (stable by
+        # construction); minreal can push a near-zero pole across the axis (seen with the
+        # distillation weight pole at -1e-6 rad/s): keep the connection as it is then.
+        logger.info("scaled_plant: minreal moved a pole into the right half plane; "
+                    "keeping the %d-state series connection", series.nstates)
+        PD = series
     if _n_unstable(PD) > _n_unstable(G0):
         raise SolverError("the scaled plant has more unstable modes than the plant")
     return PD
