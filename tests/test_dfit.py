@@ -171,6 +171,9 @@ def test_mu_check_picks_lowest_order_within_tolerance():
     # the previous order (also evaluated) failed the test
     assert len(calls) == k + 1
     assert mu_check(calls[k - 1]) > (1 + rtol) * mu_peak
+    # the constant scaling (performance block) keeps its exact order-0 fit: a shared
+    # higher order only added nearly cancelling pole/zero pairs to the scaled plant
+    assert k > 0 and res.orders[1] == (0,) and res.fits[1].nstates == 0
 
 
 def test_full_d_block_diagonal_approximation():

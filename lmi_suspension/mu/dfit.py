@@ -54,6 +54,8 @@ _ZETA_MAX = 1.0e3
 _FREQ_MARGIN = 100.0  # natural frequencies may lie this factor outside the grid
 _MAX_NFEV = 400  # per least-squares run; keeps every fit bounded in time
 _SK_ITERATIONS = 10
+#: a fit whose weighted log-magnitude error is below this matches its data exactly
+_EXACT_LOGMAG = 1e-9
 
 
 # ----------------------------------------------------------------------------- input
@@ -595,12 +597,18 @@ def fit_dscales(omega, d_blocks, *, max_order: int = 4, order: int | None = None
                            rtol, max_order, errors)
         return DScaleFit(fits, orders, errors, omega_out, "rtol", met)
 
-    # mu_check: one shared order, raised until the scaled peak is within tolerance
+    # mu_check: one shared order, raised until the scaled peak is within tolerance; an
+    # element its lower-order fit already matches (a constant d = 1 of the performance
+    # block) keeps that fit: higher orders only add nearly cancelling pole/zero pairs,
+    # which a minimal realisation of the scaled plant can push across the axis
     seqs = [[_fit_sequence(omega, mag, w, top) for mag in blk] for blk in elements]
+    exact = [[_exact_order(seq, omega, mag, w) for seq, mag in zip(sq, blk)]
+             for sq, blk in zip(seqs, elements)]
     k_range = [order] if order is not None else range(top + 1)
     best = None
     for k in k_range:
-        chosen = [[(k, *seq[k]) for seq in blk] for blk in seqs]
+        chosen = [[(min(k, ke), *seq[min(k, ke)]) for seq, ke in zip(sq, ex)]
+                  for sq, ex in zip(seqs, exact)]
         fits, orders, errors = assemble(chosen)
         value = float(mu_check(fits))
         if not np.isfinite(value):
@@ -617,6 +625,16 @@ def fit_dscales(omega, d_blocks, *, max_order: int = 4, order: int | None = None
                "scaled peak %.4g exceeds (1+rtol)*mu_peak = %.4g up to order %d",
                best[3], (1 + rtol) * mu_peak, top)
     return DScaleFit(*best[:3], omega_out, "mu_check", False, best[3])
+
+
+def _exact_order(seq, omega, mag, w, tol: float = _EXACT_LOGMAG) -> int:
+    """Lowest order in ``seq`` whose fit matches ``mag`` to ``tol`` (log-magnitude), or
+    the highest order if none does."""
+    logmag = np.log(mag)
+    for k, (theta, omega0) in enumerate(seq):
+        if _fit_error(theta, k, (omega / omega0) ** 2, logmag, w) <= tol:
+            return k
+    return len(seq) - 1
 
 
 def _ss_inverse(sys: control.StateSpace) -> control.StateSpace:
