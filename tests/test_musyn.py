@@ -185,8 +185,11 @@ def test_overrelaxed_dscales_beat_plain_dk():
 
 def test_overrelaxation_restarts_from_the_best_iterate(monkeypatch):
     """When an iterate is not the best, the next D-step starts again from the best
-    iterate's scalings; if that does not help either, the loop stops there.  Forced
-    here by a K-step that falls back to the first controller from iteration 3 on."""
+    iterate's scalings; if that restart does not help either, the step after it is a
+    plain one from where the loop is (repeating the restart would repeat it exactly).
+    Forced here by a K-step that falls back to the first controller from iteration 3 on;
+    which controller each scaled plant was built around shows in gamma_prev, that
+    controller's norm on it (an independent hinfnorm)."""
     from lmi_suspension.mu import dk
 
     real, first = dk._k_step, []
@@ -199,13 +202,16 @@ def test_overrelaxation_restarts_from_the_best_iterate(monkeypatch):
     monkeypatch.setattr(dk, "_k_step", stale)
     ex = skogestad_distillation()
     res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-3, 3, 61),
-                options=MusynOptions(max_iter=8, patience=5, min_improvement=0.0,
+                options=MusynOptions(max_iter=8, patience=3, min_improvement=0.0,
                                      method="riccati", dscale_overrelax=2.0))
-    peaks = [h.mu_peak for h in res.history]
-    assert len(peaks) == 4 and peaks[2] > peaks[1] and peaks[3] > peaks[1]
-    assert res.best_iteration == 2
-    assert "restarted from iteration 2" in res.stop_reason
-    np.testing.assert_array_equal(res.K.A, res.history[1].K.A)
+    h = res.history
+    assert len(h) == 5 and "no improvement" in res.stop_reason
+    assert res.best_iteration == 2 and all(r.mu_peak > h[1].mu_peak for r in h[2:])
+    # iteration 4's plant: restarted from iteration 2 (built around its controller, µ 1.03)
+    assert h[3].gamma_prev < 1.1
+    # iteration 5's plant: a plain step around iteration 4's controller (µ 1.18)
+    assert h[4].gamma_prev > 1.15
+    np.testing.assert_array_equal(res.K.A, h[1].K.A)
 
 
 def test_overrelaxed_fit_that_peaks_off_the_grid_is_replaced():
@@ -221,6 +227,37 @@ def test_overrelaxed_fit_that_peaks_off_the_grid_is_replaced():
     assert len(h) == 5
     assert all(r.gamma_prev < 1.1 * p.mu_peak for p, r in zip(h, h[1:]))
     assert max(r.mu_peak for r in h[1:]) < 1.05
+
+
+def test_kstep_on_a_balanced_realization_is_certified_on_the_plant(monkeypatch):
+    """method="best": when the Riccati search on the scaled plant as given and diagonally
+    balanced does not beat the previous controller (SLICOT failed so on D-scaled
+    distillation plants, Riccati rcond 1e-11), it runs on a Gramian-balanced realization;
+    that controller's γ is re-certified on the plant itself.  Forced here by making the
+    first two variants fail."""
+    from lmi_suspension.errors import InfeasibleError
+    from lmi_suspension.lti import hinfnorm
+    from lmi_suspension.mu import dk
+
+    ex = skogestad_distillation()
+    calls = []
+
+    def fake_hinfsyn(P, nmeas, ncon, *, method, options):
+        calls.append((method, P.nstates, options.riccati_scale))
+        if len(calls) <= 2:
+            raise InfeasibleError("forced")
+        return hinfsyn(P, nmeas, ncon, method=method, options=options)
+
+    syn = dk._k_step(fake_hinfsyn, ex.P, ex.nmeas, ex.ncon, MusynOptions(method="best"),
+                     gamma_prev=1.5)
+    assert [c[0] for c in calls[:3]] == ["riccati"] * 3
+    assert any("Gramian-balanced" in w for w in syn.warnings)
+    assert syn.gamma == pytest.approx(hinfnorm(lft(ex.P, syn.K))[0], rel=1e-12)
+    assert syn.gamma < 1.5  # the balanced realization's controller is a good one
+    # the realization has the plant's frequency response (python-control, evaluated here)
+    Pb, w = dk._gramian_balanced(ex.P), np.array([1e-4, 0.1, 10.0])
+    np.testing.assert_allclose(freqresp(Pb, w), freqresp(ex.P, w), rtol=1e-6,
+                               atol=1e-9 * np.abs(freqresp(ex.P, w)).max())
 
 
 def test_blk_must_fit_the_plant():
