@@ -43,7 +43,7 @@ def test_distillation_improves_on_the_open_source_plateau(distillation_design):
     (2026-11-23) with the bisection Riccati K-step and over-relaxed D-scales: µ 1.1798,
     1.0344, 1.0272, 1.0211, 1.0164, 1.0123 on the design grid (the book's script: 1.1798,
     1.0275, 1.0207, 1.0130, 1.0069, 1.0023); plain D-K steps gave 1.0184 at iteration 6.
-    The MATLAB level (µ < 1 from iteration 7) is NOT reached: ten iterations give 1.0082.
+    The MATLAB level (µ < 1 from iteration 7) is NOT reached: ten iterations give 1.0075.
     """
     ex, res, _ = distillation_design
     assert res.history[0].mu_peak == pytest.approx(PUBLISHED_MU_ITER1, rel=0.005)
