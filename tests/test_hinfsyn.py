@@ -72,10 +72,10 @@ def test_result_unpacks_like_python_control_and_is_frozen():
 
 
 def test_timings_book_every_solve_as_reconstruction(monkeypatch):
-    """``timings.certify`` is the certificate alone: the solve of a tightening probe
-    belongs to ``reconstruct`` (it was booked as certification: 5.9 s "certify" on the
-    22-state benchmark plant, measured).  Every controller LMI solve is slowed here by
-    0.2 s; seed 0 tightens (two controller solves)."""
+    """``timings.certify`` is the certificate alone: the solve of a reconstruction made
+    through a probe (the tightening level, tried first) belongs to ``reconstruct`` (it was
+    booked as certification: 5.9 s "certify" on the 22-state benchmark plant, measured).
+    Every controller LMI solve is slowed here by 0.2 s."""
     import time
 
     from lmi_suspension.synthesis import lmi
@@ -89,9 +89,9 @@ def test_timings_book_every_solve_as_reconstruction(monkeypatch):
     monkeypatch.setattr(lmi.ControllerLmi, "controller", slow)
     P = random_plant(4, 2, 1, 2, 1, rng=np.random.default_rng(0))
     res = hinfsyn(P, P.ny, P.nu)
-    assert any("tightened" in w for w in res.warnings)
+    assert any("tightening level" in w for w in res.warnings)
     assert res.timings.certify < 0.2
-    assert res.timings.reconstruct >= 0.4
+    assert res.timings.reconstruct >= 0.2
 
 
 def test_d22_loop_shifting_keeps_gamma():

@@ -327,13 +327,14 @@ def _polish(G: GeneralizedPlant, sc: PlantScaling, used: tuple, result: tuple,
 
 
 def _tighten(G: GeneralizedPlant, sc: PlantScaling, used: tuple, result: tuple,
-             gamma_lower: float, opts: HinfsynOptions, warnings: list) -> tuple:
+             gamma_lower: float, opts: HinfsynOptions, warnings: list,
+             factors: tuple = (10.0, 1000.0)) -> tuple:
     """One reconstruction nearer the optimum when the certified γ is more than
     ``tighten_rtol`` above it (the relaxation that keeps the controller well
     conditioned costs up to ``gamma_relax``); kept only if it certifies lower."""
     g_try = gamma_lower * (1.0 + 0.8 * opts.tighten_rtol)
     lmi_k, trace_bound = used
-    for factor in (10.0, 1000.0):
+    for factor in factors:
         # nearer the optimum X and Y grow: widen the trace box that bounds them
         probe, why, probe_warn = _probe(G, sc, (lmi_k, trace_bound * factor), g_try, opts)
         if probe is not None and probe[2] < result[2]:
@@ -420,7 +421,25 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
 
     t2 = time.perf_counter()
     result, used = None, None
-    for attempt in range(int(opts.max_recoveries) + 1):
+    tight = (opts.gamma is None and n > 0 and not tiny_optimum and opts.tighten_rtol > 0
+             and gamma_lower > 0.0)
+    if tight:
+        # The tightening level first, in the balanced frame with the box the tightening
+        # uses: where it certifies (most plants) the relaxed reconstruction is one
+        # controller-LMI solve saved (3.9 s of 14 s on the 22-state benchmark plant).
+        _frame, lmi_k, trace0 = frames.get(0)
+        box = opts.center_trace * trace0 * 10.0
+        g_try = gamma_lower * (1.0 + 0.8 * opts.tighten_rtol)
+        probe, why, probe_warn = _probe(G, sc, (lmi_k, box), g_try, opts)
+        if probe is not None and probe[2] <= g_try * (1.0 + opts.cert_rtol):
+            result, used = probe, (lmi_k, box)
+            warnings.append(f"reconstructed at the tightening level {g_try:.6g}: "
+                            f"certified {probe[2]:.6g}")
+            warnings.extend(probe_warn)
+        else:
+            warnings.append(f"reconstruction at the tightening level {g_try:.6g} failed "
+                            f"({why}); relaxed reconstruction instead")
+    for attempt in range(int(opts.max_recoveries) + 1 if result is None else 0):
         g_ctrl = g_base * (1.0 + relax)
         try:
             if n == 0:
@@ -468,10 +487,10 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
         warnings.append(f"certified gamma {result[2]:.6g} is below the LMI optimum "
                         f"{gamma_lower:.6g}: the γ minimisation was inaccurate")
         result = _polish(G, sc, used, result, opts, warnings)
-    elif opts.gamma is None and gamma_lower is not None and used is not None \
-            and not tiny_optimum and opts.tighten_rtol > 0 \
-            and result[2] > gamma_lower * (1.0 + opts.tighten_rtol):
-        result = _tighten(G, sc, used, result, gamma_lower, opts, warnings)
+    elif tight and used is not None and result[2] > gamma_lower * (1.0 + opts.tighten_rtol):
+        # the tightening level failed in the default box above: a wider box
+        result = _tighten(G, sc, used, result, gamma_lower, opts, warnings,
+                          factors=(1000.0,))
     K, CL, gamma, poles, g_ctrl, status, cond_xy, cond_lyap, t_cert = result
     t_rec = time.perf_counter() - t2 - t_cert
     return HinfsynResult(

@@ -192,6 +192,8 @@ class HinfsynResult:
         The solver's own bound (the γ of the reconstruction LMI, or Riccati γ).
     gamma_lower : float or None
         LMI optimum: no controller of any order achieves less (up to solver accuracy).
+        When the returned controller certifies below it, ``warnings`` says that the γ
+        minimisation was inaccurate, and it is no lower bound (COMPleib AC4).
     poles : numpy.ndarray
         Closed-loop poles.
     status : str
