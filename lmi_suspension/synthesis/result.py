@@ -85,8 +85,8 @@ class HinfsynOptions:
         more controller is reconstructed at ``(1 + 0.8 tighten_rtol)`` times the optimum
         and kept if it certifies lower (``0`` disables).
     polish_steps : int
-        When the reconstructed controller certifies *below* the LMI optimum (the γ
-        minimisation stopped early), up to this many re-solves of the controller LMI at a
+        When the reconstructed controller certifies below the LMI optimum by more than
+        ``gamma_relax`` (the γ minimisation stopped early), up to this many re-solves of the controller LMI at a
         level below the best certified one; each is kept only if its controller
         certifies lower.
     polish_step : float
