@@ -217,3 +217,29 @@ def test_failed_comparison_design_is_recorded(monkeypatch, tmp_path):
     assert summary.controller("hinf_riccati").error
     assert "design failed" in R.comparison_table(summary)
     assert (tmp_path / "peak_vs_delay.png").stat().st_size > 0
+
+
+@pytest.mark.slow
+def test_roads_and_monte_carlo_do_not_depend_on_the_design_draws(monkeypatch, tmp_path):
+    """Each stage has its own random stream: a design that draws more random numbers
+    (the µ lower bound's restarts did, after a change of algorithm) leaves the noise road
+    and the Monte-Carlo samples unchanged.  Two runs from the same seed, with a design
+    that draws nothing and one that draws 1000 numbers."""
+    results = []
+    for draws in (0, 1000):
+        api, *_ = _stand_in()
+        design = api.design_mu_controller
+
+        def drawing_design(*args, rng=None, _d=design, _n=draws, **kwargs):
+            rng.standard_normal(_n)
+            return _d(*args, rng=rng, **kwargs)
+
+        api.design_mu_controller = drawing_design
+        monkeypatch.setattr(R, "_design_api", lambda api=api: api)
+        out = tmp_path / f"draws{draws}"
+        R.reproduce(out, rng=np.random.default_rng(3), delays=(0.0,), quick=True)
+        results.append(json.loads((out / "summary.json").read_text()))
+    a, b = results
+    assert a["monte_carlo"] == b["monte_carlo"]
+    assert a["controllers"]["passive"] == b["controllers"]["passive"]
+    assert a["iso_C"] == b["iso_C"]

@@ -233,7 +233,8 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     progress : callable, optional
         Called with one line of text per stage and per D-K iteration.
     rng : numpy.random.Generator, optional
-        Source of every random number (noise road, ISO road, Monte-Carlo, design);
+        Source of every random number: it seeds one independent stream each for the
+        design, the µ analysis, the noise road, the ISO road and the Monte-Carlo samples;
         ``numpy.random.default_rng(0)`` if omitted, so the run is reproducible.
     delays : sequence of float
         Actuator delays to simulate, s.
@@ -274,6 +275,11 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         rng = np.random.default_rng(0)
     if not isinstance(rng, np.random.Generator):
         raise ParameterError("rng must be a numpy.random.Generator")
+    # one independent stream per stage, so that the roads and the Monte-Carlo samples do
+    # not change when an algorithm upstream draws a different number of random numbers
+    # (the µ lower bound's restarts did, and moved the Monte-Carlo worst case)
+    rng_design, rng_analysis, rng_noise, rng_iso, rng_mc = (
+        np.random.default_rng(int(seed)) for seed in rng.integers(2**63, size=5))
     delays = _check_delays(delays)
     cfg = _QUICK if quick else _FULL
     if quick and len(delays) > 2:
@@ -302,12 +308,12 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
             f"{rec.mu_peak:.4f}, µ lower = {rec.mu_lower_peak:.4f} "
             f"({rec.seconds_k + rec.seconds_d + rec.seconds_fit:.1f} s)")
 
-    mu_design = api.design_mu_controller(callback=on_iteration, rng=rng)
+    mu_design = api.design_mu_controller(callback=on_iteration, rng=rng_design)
     done(tok)
     say(f"  µ peak upper {mu_design.mu_peak:.4f}, lower {mu_design.mu_lower_peak:.4f}, "
         f"controller order {mu_design.K.nstates}")
     tok = stage("mu_analysis", "µ analysis with the paper's norm-bounded uncertainty ...")
-    mu_checks = api.analyse_uncertainty(mu_design.K, rng=rng)
+    mu_checks = api.analyse_uncertainty(mu_design.K, rng=rng_analysis)
     for check in mu_checks:
         say(f"  {check.structure}: µ upper {check.mu_peak:.4f}, lower "
             f"{check.mu_lower_peak:.4f}")
@@ -329,7 +335,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     # --- roads and the physical limit ------------------------------------------------
     road_bump = bump(t_end=cfg.bump_t_end, dt=cfg.road_dt)
     road_noise = white_noise(cfg.noise_t_end, cfg.road_dt, psd=_NOISE_PSD,
-                             bandwidth_hz=_NOISE_BAND_HZ, rng=rng)
+                             bandwidth_hz=_NOISE_BAND_HZ, rng=rng_noise)
     tok = stage("limit", "physical limit of the bump (LP) ...")
     limit = bump_limit(road_bump, params, dt=cfg.limit_dt)
     done(tok)
@@ -400,7 +406,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
 
     # --- extras: ISO 8608 class C, Monte-Carlo ---------------------------------------
     tok = stage("iso_C", "ISO 8608 class-C road at 30 km/h ...")
-    road_iso = iso8608_road("C", 30.0, cfg.iso_t_end, cfg.road_dt, rng=rng)
+    road_iso = iso8608_road("C", 30.0, cfg.iso_t_end, cfg.road_dt, rng=rng_iso)
     iso_runs = {}
     iso_data: dict = {"description": road_iso.description, "results": {}}
     for name in CONTROLLER_NAMES:
@@ -416,7 +422,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
 
     tok = stage("monte_carlo", f"Monte-Carlo over the uncertainty set ({cfg.mc_n} samples, "
                 f"µ controller) ...")
-    mc = monte_carlo(mu_design.K, road_bump, n=cfg.mc_n, rng=rng,
+    mc = monte_carlo(mu_design.K, road_bump, n=cfg.mc_n, rng=rng_mc,
                      delay=(delays[0], delays[-1]), dt=dt if dt is not None else 1e-4,
                      params=params)
     worst_p = mc.params[mc.worst_index]
