@@ -19,7 +19,7 @@ import logging
 import time
 import warnings
 from dataclasses import dataclass, field, replace
-from typing import Callable
+from typing import Callable, NamedTuple
 
 import control
 import numpy as np
@@ -314,6 +314,56 @@ def _overrelaxed(d_blocks, previous: list[np.ndarray], alpha: float) -> list[np.
             for d, p in zip(d_blocks, previous)]
 
 
+class _DStep(NamedTuple):
+    """What a D-step starts from: the loop's response, its scalings, its µ, its controller."""
+
+    M: np.ndarray
+    d_blocks: object
+    upper: np.ndarray
+    mu_peak: float
+    K: control.StateSpace
+
+
+class _OverRelaxation:
+    """The D-step's choice of scalings under ``MusynOptions.dscale_overrelax``.
+
+    Holds the fit behind the current scaled plant and the best iterate's D-step.  At the
+    best iterate the fitted target is ``|D̂_prev| (d / |D̂_prev|)^α``; after an iterate that
+    is not the best, one plain step from the best iterate (α halved towards 1 from then
+    on); if that restart does not beat the best either, a plain step from where the loop
+    is, since repeating the restart would repeat it exactly.
+    """
+
+    def __init__(self, alpha: float):
+        self.alpha = alpha
+        self._fit_mag = None  # |D̂(jω)| per block of the fit behind the current plant
+        self._best = None  # _DStep of the best iterate
+        self._restarted_from = None  # the iterate the previous D-step restarted from
+
+    def step(self, it: int, best_it: int, here: _DStep):
+        """``(source, target)``: the D-step to build the next plant around, and the
+        scalings to fit."""
+        if self.alpha <= 1.0 and self._best is None:
+            return here, here.d_blocks  # plain D-K iteration
+        if best_it == it:
+            self._best, self._restarted_from = here, None
+            if self._fit_mag is None or self.alpha <= 1.0:
+                return here, here.d_blocks
+            return here, _overrelaxed(here.d_blocks, self._fit_mag, self.alpha)
+        if self._restarted_from == best_it:
+            self._restarted_from = None
+            return here, here.d_blocks
+        self._restarted_from = best_it
+        self.alpha = 1.0 + (self.alpha - 1.0) / 2.0
+        logger.info("musyn: iteration %d is not the best; next D-step from iteration %d, "
+                    "over-relaxation %.3g", it, best_it, self.alpha)
+        return self._best, self._best.d_blocks
+
+    def fitted(self, magnitudes: list[np.ndarray]) -> None:
+        """Record the fit the next scaled plant was built with."""
+        self._fit_mag = magnitudes
+
+
 def _dense_grid(omega: np.ndarray, n: int, peak: float, CL) -> np.ndarray:
     """The grid of the reported µ: ``n`` points over the design range, 41 around the
     peak, and 4 per decade from three decades below the loop's slowest pole to two above
@@ -396,10 +446,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     stop_reason = f"reached max_iter={opts.max_iter}"
     since_best = 0
     K_prev = None
-    alpha = float(opts.dscale_overrelax)
-    fit_mag = None  # |D̂(jω)| of the fit behind the current scaled plant
-    best_dstep = None  # (M, d_blocks, upper, mu_peak, K) of the best iterate
-    restarted_from = None  # the best iterate the previous D-step restarted from
+    relax = _OverRelaxation(float(opts.dscale_overrelax))
     for it in range(1, int(opts.max_iter) + 1):
         t0 = time.perf_counter()
         # what the previous controller achieves on the new scaled plant
@@ -438,7 +485,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
                      and syn.gamma > gamma_prev * (1 + _KSTEP_RTOL)
                      # over-relaxed scalings can give a plant the K-step handles badly;
                      # the next D-step then restarts from the best iterate instead
-                     and not (alpha > 1.0 and best[2] != it))
+                     and not (relax.alpha > 1.0 and best[2] != it))
         if mu_peak < opts.mu_target:
             done = f"µ peak {mu_peak:.4f} below target {opts.mu_target}"
         elif regressed:
@@ -455,26 +502,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
         K_ref = K  # the controller the next scaled plant is built around
         t3 = time.perf_counter()
         if done is None:
-            src = (M, mu.d_blocks, upper, mu_peak, K)
-            d_target = mu.d_blocks
-            if opts.dscale_overrelax > 1.0:
-                if best[2] == it:
-                    best_dstep, restarted_from = src, None
-                    if fit_mag is not None:
-                        d_target = _overrelaxed(mu.d_blocks, fit_mag, alpha)
-                elif restarted_from == best[2]:
-                    # a plain step from the best iterate did not beat it either (running
-                    # it again would repeat it exactly): a plain step from here
-                    restarted_from = None
-                else:
-                    # the extrapolated scalings overshot: one plain step from the best
-                    # iterate, and a smaller over-relaxation from then on
-                    src = best_dstep
-                    d_target = src[1]
-                    restarted_from = best[2]
-                    alpha = 1.0 + (alpha - 1.0) / 2.0
-                    logger.info("musyn: iteration %d is not the best; next D-step from "
-                                "iteration %d, over-relaxation %.3g", it, best[2], alpha)
+            src, d_target = relax.step(it, best[2], _DStep(M, mu.d_blocks, upper, mu_peak, K))
             M_s, d_plain, upper_s, peak_s, K_ref = src
             # Emphasise the frequencies that set the peak: the fit matters most there.
             weights = 0.2 + upper_s / peak_s
@@ -501,7 +529,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
                         dfit, PD_next = scaled(d_plain)
                 PD = PD_next
                 orders = tuple(max(o) for o in dfit.orders)
-                fit_mag = _fit_magnitudes(dfit, omega)
+                relax.fitted(_fit_magnitudes(dfit, omega))
             except LmiSuspensionError as exc:
                 # no usable scaled plant for the next K-step: end with the best iterate
                 done = f"D-fit failed after iteration {it}: {exc}"
