@@ -565,20 +565,28 @@ def _align_Q(struct, a, z, real_sign):
     return Q
 
 
-def _power_step_full(M, MH, a, w, rl, cl, m):
-    """One Packard–Doyle step for full blocks only, vectorised over blocks.
+def _block_indicators(struct: BlockStructure):
+    """``E_r`` (n_out × m) and ``E_c`` (n_in × m): which block each row / column is in."""
+    rl, cl = _block_labels(struct)
+    blocks = np.arange(struct.n_blocks)[None, :]
+    return (rl[:, None] == blocks).astype(float), (cl[:, None] == blocks).astype(float)
+
+
+def _power_step_full(M, MH, a, w, Er, Ec):
+    """One Packard–Doyle step for full blocks only, vectorised over blocks, on one matrix
+    (``a``, ``w`` vectors) or a stack (leading frequency axis on ``M``, ``MH``, ``a``,
+    ``w``).
 
     With ``z = M* w``, the aligned ``Q_i = z_i a_i* / (|z_i| |a_i|)`` gives
     ``Q a = (|a_i|/|z_i|) z_i`` and ``Q* z = (|z_i|/|a_i|) a_i`` blockwise.
     """
-    z = MH @ w
-    na = np.sqrt(np.bincount(rl, np.abs(a) ** 2, minlength=m))
-    nz = np.sqrt(np.bincount(cl, np.abs(z) ** 2, minlength=m))
+    z = np.einsum("...ij,...j->...i", MH, w)
+    na = np.sqrt(np.abs(a) ** 2 @ Er)
+    nz = np.sqrt(np.abs(z) ** 2 @ Ec)
     ok = (na > 0) & (nz > 0)
     ratio = np.where(ok, na / np.where(ok, nz, 1.0), 0.0)
-    b = ratio[cl] * z
-    wn = np.where(ok, 1.0 / np.where(ok, ratio, 1.0), 0.0)[rl] * a
-    return M @ b, wn
+    inv = np.where(ok, 1.0 / np.where(ok, ratio, 1.0), 0.0)
+    return np.einsum("...ij,...j->...i", M, (ratio @ Ec.T) * z), (inv @ Er.T) * a
 
 
 def _check_delta(M, Delta, opts):
@@ -646,8 +654,6 @@ def _power_lower(M, struct, rng, starts, opts, target=np.inf):
     nout = struct.n_out
     has_real = struct.has_real
     full_only = struct.is_complex_full_only
-    rl, cl = _block_labels(struct)
-    m = struct.n_blocks
     best = (0.0, None, None)
     MH = M.conj().T
 
@@ -656,13 +662,14 @@ def _power_lower(M, struct, rng, starts, opts, target=np.inf):
         for _ in range(opts.power_restarts + (1 if not starts else 0)):
             yield tuple(rng.standard_normal(nout) + 1j * rng.standard_normal(nout) for _ in range(2))
 
+    Er, Ec = _block_indicators(struct) if full_only else (None, None)
     for a, w in starts_iter():
         a = a / max(np.linalg.norm(a), 1e-300)
         w = w / max(np.linalg.norm(w), 1e-300)
         prev = -1.0
         for _ in range(opts.power_maxiter):
             if full_only:
-                an, wn = _power_step_full(M, MH, a, w, rl, cl, m)
+                an, wn = _power_step_full(M, MH, a, w, Er, Ec)
             else:
                 z = MH @ w
                 Q = _align_Q(struct, a, z, real_sign=False)
@@ -711,9 +718,7 @@ def _power_lower_full_batch(stack, struct, rng, opts, DL, DR, upper):
     M = np.ascontiguousarray(np.moveaxis(stack, -1, 0))  # nf x nout x nin
     MH = np.conj(np.swapaxes(M, 1, 2))
     rl, cl = _block_labels(struct)
-    m = struct.n_blocks
-    Er = (rl[:, None] == np.arange(m)[None, :]).astype(float)  # nout x m
-    Ec = (cl[:, None] == np.arange(m)[None, :]).astype(float)  # nin x m
+    Er, Ec = _block_indicators(struct)
     mask = cl[:, None] == rl[None, :]  # nin x nout: the block diagonal of Δ
 
     def iterate(idx, a, w):
@@ -722,15 +727,7 @@ def _power_lower_full_batch(stack, struct, rng, opts, DL, DR, upper):
         prev = np.full(idx.size, -1.0)
         act = np.arange(idx.size)
         for _ in range(opts.power_maxiter):
-            Mi, a_i = M[idx[act]], a[act]
-            z = np.einsum("fij,fj->fi", MH[idx[act]], w[act])
-            na = np.sqrt(np.abs(a_i) ** 2 @ Er)
-            nz = np.sqrt(np.abs(z) ** 2 @ Ec)
-            ok = (na > 0) & (nz > 0)
-            ratio = np.where(ok, na / np.where(ok, nz, 1.0), 0.0)
-            inv = np.where(ok, 1.0 / np.where(ok, ratio, 1.0), 0.0)
-            an = np.einsum("fij,fj->fi", Mi, (ratio @ Ec.T) * z)
-            wn = (inv @ Er.T) * a_i
+            an, wn = _power_step_full(M[idx[act]], MH[idx[act]], a[act], w[act], Er, Ec)
             n_a, n_w = np.linalg.norm(an, axis=1), np.linalg.norm(wn, axis=1)
             alive = (n_a > 0) & (n_w > 0)
             a[act[alive]] = an[alive] / n_a[alive, None]

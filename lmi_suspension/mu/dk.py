@@ -447,11 +447,17 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     since_best = 0
     K_prev = None
     relax = _OverRelaxation(float(opts.dscale_overrelax))
+    gamma_next = None  # K_prev's norm on the next scaled plant, when the D-step has it
     for it in range(1, int(opts.max_iter) + 1):
         t0 = time.perf_counter()
-        # what the previous controller achieves on the new scaled plant
-        gamma_prev = (float(hinfnorm(lft(PD, K_prev, nmeas, ncon))[0]) if K_prev is not None
-                      else float("nan"))
+        # what the previous controller achieves on the new scaled plant (computed by the
+        # D-step already when it checked an over-relaxed fit)
+        if gamma_next is not None:
+            gamma_prev = gamma_next
+        else:
+            gamma_prev = (float(hinfnorm(lft(PD, K_prev, nmeas, ncon))[0])
+                          if K_prev is not None else float("nan"))
+        gamma_next = None
         try:
             syn = _k_step(hinfsyn, PD, nmeas, ncon, opts, gamma_prev)
         except LmiSuspensionError as exc:
@@ -521,12 +527,13 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
                     # beyond the grid points; the controller's norm on the new scaled
                     # plant can (an extrapolated fit on a coarse grid gave 1739 there
                     # against 1.04 on the grid, measured)
-                    g_ref = float(hinfnorm(lft(PD_next, K_ref, nmeas, ncon))[0])
-                    if not g_ref <= dfit.mu_value * (1 + _OFFGRID_RTOL):
+                    gamma_next = float(hinfnorm(lft(PD_next, K_ref, nmeas, ncon))[0])
+                    if not gamma_next <= dfit.mu_value * (1 + _OFFGRID_RTOL):
                         logger.info("musyn: over-relaxed D-fit peaks off the grid (%.4g "
-                                    "against %.4g); plain D-step instead", g_ref,
+                                    "against %.4g); plain D-step instead", gamma_next,
                                     dfit.mu_value)
                         dfit, PD_next = scaled(d_plain)
+                        gamma_next = None
                 PD = PD_next
                 orders = tuple(max(o) for o in dfit.orders)
                 relax.fitted(_fit_magnitudes(dfit, omega))
@@ -618,12 +625,16 @@ def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
     if opts.method != "best":
         return hinfsyn(PD, nmeas, ncon, method=opts.method, options=base)
     results, errors = [], []
+
+    def previous_beaten() -> bool:
+        return bool(results) and min(r.gamma for r in results) <= gamma_prev * (1 + _KSTEP_RTOL)
+
     for method, scale in (("riccati", False), ("riccati", True), ("riccati", "gramian"),
                           ("lmi", None)):
         plant = PD
         options = replace(base, riccati_scale=scale is True) if method == "riccati" else base
         if scale == "gramian":
-            if results and min(r.gamma for r in results) <= gamma_prev * (1 + _KSTEP_RTOL):
+            if previous_beaten():
                 continue  # only where the other two did not beat the previous controller
             plant = _gramian_balanced(PD)
             if plant is None:
@@ -633,14 +644,13 @@ def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
             logger.info("musyn: no LMI fallback on a %d-state scaled plant", PD.nstates)
             break
         if method == "lmi" and results and base.gamma is None:
-            best_riccati = min(r.gamma for r in results)
-            if best_riccati <= gamma_prev * (1 + _KSTEP_RTOL):
+            if previous_beaten():
                 # Riccati already improves on the previous controller; the LMI is the
                 # fallback (on 22-state D-scaled plants its γ minimisation fails and
                 # costs more than the rest of the iteration, measured on distillation)
                 break
             # an LMI optimum far above a certified Riccati γ is a failed solve: stop early
-            options = replace(base, gamma_abort=2.0 * best_riccati)
+            options = replace(base, gamma_abort=2.0 * min(r.gamma for r in results))
         try:
             res = hinfsyn(plant, nmeas, ncon, method=method, options=options)
         except LmiSuspensionError as exc:

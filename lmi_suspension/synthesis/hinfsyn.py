@@ -327,21 +327,17 @@ def _polish(G: GeneralizedPlant, sc: PlantScaling, used: tuple, result: tuple,
 
 
 def _tighten(G: GeneralizedPlant, sc: PlantScaling, used: tuple, result: tuple,
-             gamma_lower: float, opts: HinfsynOptions, warnings: list,
-             factors: tuple = (10.0, 1000.0)) -> tuple:
-    """One reconstruction nearer the optimum when the certified γ is more than
-    ``tighten_rtol`` above it (the relaxation that keeps the controller well
-    conditioned costs up to ``gamma_relax``); kept only if it certifies lower."""
-    g_try = gamma_lower * (1.0 + 0.8 * opts.tighten_rtol)
+             g_try: float, opts: HinfsynOptions, warnings: list) -> tuple:
+    """The tightening level ``g_try`` again, in a trace box 1000 times wider than the one
+    that gave ``result`` (nearer the optimum X and Y grow), after it failed in the
+    default box; kept only if it certifies lower."""
     lmi_k, trace_bound = used
-    for factor in factors:
-        # nearer the optimum X and Y grow: widen the trace box that bounds them
-        probe, why, probe_warn = _probe(G, sc, (lmi_k, trace_bound * factor), g_try, opts)
-        if probe is not None and probe[2] < result[2]:
-            warnings.append(f"tightened: certified {probe[2]:.6g} at gamma={g_try:.6g} "
-                            f"(was {result[2]:.6g})")
-            warnings.extend(probe_warn)
-            return probe
+    probe, why, probe_warn = _probe(G, sc, (lmi_k, trace_bound * 1000.0), g_try, opts)
+    if probe is not None and probe[2] < result[2]:
+        warnings.append(f"tightened: certified {probe[2]:.6g} at gamma={g_try:.6g} "
+                        f"(was {result[2]:.6g})")
+        warnings.extend(probe_warn)
+        return probe
     warnings.append(f"tightening at gamma={g_try:.6g} kept the first controller: {why}")
     return result
 
@@ -429,16 +425,17 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
         # controller-LMI solve saved (3.9 s of 14 s on the 22-state benchmark plant).
         _frame, lmi_k, trace0 = frames.get(0)
         box = opts.center_trace * trace0 * 10.0
-        g_try = gamma_lower * (1.0 + 0.8 * opts.tighten_rtol)
-        probe, why, probe_warn = _probe(G, sc, (lmi_k, box), g_try, opts)
-        if probe is not None and probe[2] <= g_try * (1.0 + opts.cert_rtol):
+        g_tight = gamma_lower * (1.0 + 0.8 * opts.tighten_rtol)
+        probe, why, probe_warn = _probe(G, sc, (lmi_k, box), g_tight, opts)
+        if probe is not None and probe[2] <= g_tight * (1.0 + opts.cert_rtol):
             result, used = probe, (lmi_k, box)
-            warnings.append(f"reconstructed at the tightening level {g_try:.6g}: "
+            warnings.append(f"reconstructed at the tightening level {g_tight:.6g}: "
                             f"certified {probe[2]:.6g}")
             warnings.extend(probe_warn)
         else:
-            warnings.append(f"reconstruction at the tightening level {g_try:.6g} failed "
+            warnings.append(f"reconstruction at the tightening level {g_tight:.6g} failed "
                             f"({why}); relaxed reconstruction instead")
+    tight_failed = result is None
     for attempt in range(int(opts.max_recoveries) + 1 if result is None else 0):
         g_ctrl = g_base * (1.0 + relax)
         try:
@@ -490,10 +487,9 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
         warnings.append(f"certified gamma {result[2]:.6g} is below the LMI optimum "
                         f"{gamma_lower:.6g}: the γ minimisation was inaccurate")
         result = _polish(G, sc, used, result, opts, warnings)
-    elif tight and used is not None and result[2] > gamma_lower * (1.0 + opts.tighten_rtol):
-        # the tightening level failed in the default box above: a wider box
-        result = _tighten(G, sc, used, result, gamma_lower, opts, warnings,
-                          factors=(1000.0,))
+    elif tight and tight_failed and used is not None \
+            and result[2] > gamma_lower * (1.0 + opts.tighten_rtol):
+        result = _tighten(G, sc, used, result, g_tight, opts, warnings)
     K, CL, gamma, poles, g_ctrl, status, cond_xy, cond_lyap, t_cert = result
     t_rec = time.perf_counter() - t2 - t_cert
     return HinfsynResult(

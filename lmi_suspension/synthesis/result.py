@@ -81,14 +81,16 @@ class HinfsynOptions:
         certified to achieve: the minimisation has then failed, and reconstructing
         around it is wasted time).  Used by ``musyn``'s ``method="best"``.
     tighten_rtol : float
-        When the certified γ is more than this (relative) above the LMI optimum, one
-        more controller is reconstructed at ``(1 + 0.8 tighten_rtol)`` times the optimum
-        and kept if it certifies lower (``0`` disables).
+        The controller is first reconstructed at ``(1 + 0.8 tighten_rtol)`` times the LMI
+        optimum; where that does not certify, at the relaxed level (``gamma_relax``), and
+        if that is more than ``tighten_rtol`` above the optimum, the tightening level is
+        tried once more in a wider trace box and kept if it certifies lower (``0``
+        reconstructs at the relaxed level only).
     polish_steps : int
         When the reconstructed controller certifies below the LMI optimum by more than
-        ``gamma_relax`` (the γ minimisation stopped early), up to this many re-solves of the controller LMI at a
-        level below the best certified one; each is kept only if its controller
-        certifies lower.
+        ``gamma_relax`` (the γ minimisation stopped early), up to this many re-solves of
+        the controller LMI at a level below the best certified one; each is kept only if
+        its controller certifies lower.
     polish_step : float
         Relative step of the first polish probe, halved after each probe that fails.
     direct_solve_method : str
