@@ -16,15 +16,22 @@ from lmi_suspension.mu import MusynOptions, musyn
 OMEGA = np.logspace(-3, 3, 61)  # the grid of dkpy's README example of this problem
 
 
+OFF = {"dscale_search": 0}  # D-K iterations only
+
+
 @pytest.mark.parametrize("method, max_iter, extra", [
-    ("riccati", 10, {}), ("lmi", 10, {}), ("best", 10, {}), ("best", 3, {}),
+    ("riccati", 10, OFF), ("lmi", 10, OFF), ("best", 10, OFF), ("best", 3, OFF),
     # plain D-K steps, as before the over-relaxed D-step became the default
-    ("best", 10, {"dscale_overrelax": 1.0}),
+    ("best", 10, {"dscale_overrelax": 1.0, **OFF}),
     # fits of the largest order at every iteration (4 as in the book's script, then 5),
     # run until no progress in 5 iterations
-    ("best", 25, {"dfit_rtol": 1e-3, "patience": 5, "min_improvement": 0.0}),
+    ("best", 25, {"dfit_rtol": 1e-3, "patience": 5, "min_improvement": 0.0, **OFF}),
     ("best", 25, {"dfit_rtol": 1e-3, "max_dfit_order": 5, "patience": 5,
-                  "min_improvement": 0.0}),
+                  "min_improvement": 0.0, **OFF}),
+    # the defaults: D-K, then the direct D-scale search (100 K-steps at most); a longer
+    # search after three iterations; and the time to certify µ < 1 (MATLAB's level)
+    ("best", 3, {}), ("best", 10, {}), ("best", 3, {"dscale_search": 300}),
+    ("best", 3, {"mu_target": 1.0}),
 ], ids=lambda v: "-".join(f"{k}={x}" for k, x in v.items()) if isinstance(v, dict) else None)
 def test_bench_musyn_distillation(benchmark, method, max_iter, extra):
     # three iterations match dkpy's configuration below (fit_orders=[4, 4, 4])
@@ -41,6 +48,7 @@ def test_bench_musyn_distillation(benchmark, method, max_iter, extra):
     benchmark.extra_info["gamma_prev_per_iteration"] = [h.gamma_prev for h in res.history]
     benchmark.extra_info["stop_reason"] = res.stop_reason
     benchmark.extra_info["seconds_k_per_iteration"] = [h.seconds_k for h in res.history]
+    benchmark.extra_info["stage_per_iteration"] = [h.stage for h in res.history]
     assert res.mu_lower_peak <= res.mu_peak
 
 

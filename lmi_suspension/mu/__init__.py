@@ -1,11 +1,13 @@
 """Structured singular value µ and µ-synthesis.
 
-block structures -> bounds (``mussv``) -> rational D-scale fits -> D-K iteration (``musyn``).
+block structures -> bounds (``mussv``) -> rational D-scale fits -> D-K iteration (``musyn``)
+-> direct D-scale search (``search_dscales``, run by ``musyn`` after the loop).
 """
 
 from .blocks import Block, BlockKind, BlockStructure
 from .bounds import MussvOptions, MussvResult, MussvTimings, mussv
 from .dfit import DScaleFit, fit_dscales, fit_magnitude, scaled_plant
+from .dsearch import DScaleSearchResult, search_dscales
 from .dk import MusynIteration, MusynOptions, MusynResult, default_omega, musyn
 from .plot import plot_dscales, plot_mu
 
@@ -22,6 +24,8 @@ __all__ = [
     "fit_dscales",
     "fit_magnitude",
     "scaled_plant",
+    "DScaleSearchResult",
+    "search_dscales",
     "MusynOptions",
     "MusynIteration",
     "MusynResult",

@@ -1,0 +1,184 @@
+"""Direct search on the D-scale parameters with the K-step in the loop.
+
+D-K iteration alternates two partial minimisations of the same bound and stops where
+neither step alone improves it; on Skogestad & Postlethwaite's distillation problem that
+is at µ ≈ 1.003, while the book's µ-optimal scalings give 0.974 (measured: along the
+log-linear path from the D-K scalings to those, the K-step's γ falls steadily).  This
+stage minimises what D-K minimises alternately, ``γ(θ) = min_K ‖D_θ F_l(P, K) D_θ⁻¹‖∞``,
+over the parameters ``θ`` of the rational fits themselves (poles, zeros and gain of each
+scaling, in the stable minimum-phase parametrisation of :mod:`.dfit`), by Nelder-Mead
+with restarts.  Every value is a certified closed-loop norm, so the controller it
+returns has ``µ <= γ`` at every frequency.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+import warnings
+from dataclasses import dataclass
+
+import control
+import numpy as np
+import scipy.optimize
+
+from ..errors import LmiSuspensionError
+from ..lti.norms import hinfnorm
+from ..lti.plant import lft
+from .dfit import DScaleFit, _fit_sequence, _to_statespace, scaled_plant
+
+__all__ = ["DScaleSearchResult", "search_dscales"]
+
+logger = logging.getLogger(__name__)
+
+#: a Nelder-Mead round that gains less than this (relative) ends the search
+_RESTART_RTOL = 1e-4
+
+
+@dataclass(frozen=True)
+class DScaleSearchResult:
+    """Outcome of :func:`search_dscales`.
+
+    Attributes
+    ----------
+    K : control.StateSpace
+        Controller of the best scalings found.
+    gamma : float
+        Its certified norm on the scaled plant (an upper bound of µ at every frequency).
+    gamma_start : float
+        The same at the starting scalings.
+    dfit : DScaleFit
+        The best scalings.
+    evaluations : int
+        K-steps run.
+    seconds : float
+        Wall time.
+    """
+
+    K: control.StateSpace
+    gamma: float
+    gamma_start: float
+    dfit: DScaleFit
+    evaluations: int
+    seconds: float
+
+
+class _Reached(Exception):
+    """The target level is certified: stop the search."""
+
+
+def search_dscales(P, nmeas: int, ncon: int, block_sizes, omega, d_blocks, weights,
+                   order: int, kstep, *, max_evals: int = 300,
+                   target: float = 0.0) -> DScaleSearchResult | None:
+    """Minimise the K-step's certified γ over the parameters of the D-scale fits.
+
+    Parameters
+    ----------
+    P : control.StateSpace
+        Generalized plant.
+    nmeas, ncon : int
+        Partition.
+    block_sizes : sequence of (int, int)
+        ``(r_i, c_i)`` of each Δ block.
+    omega : ndarray
+        Frequencies of ``d_blocks`` (rad/s).
+    d_blocks : ndarray, shape (n_blocks, n_freq)
+        Scalar D magnitudes per block (the starting point, fitted at ``order``); a block
+        equal to 1 everywhere (the normalised one) stays 1.
+    weights : ndarray
+        Weights of the starting fit.
+    order : int
+        Order of every searched scaling (>= 1).
+    kstep : callable
+        ``kstep(PD) -> K``: an H∞ synthesis on the scaled plant; any error counts as a
+        failed point.
+    max_evals : int
+        Bound on the number of K-steps.
+    target : float
+        Stop as soon as a certified γ falls below this level.
+
+    Returns
+    -------
+    DScaleSearchResult or None
+        None when no block has a scaling to search or the start gives no controller.
+
+    Examples
+    --------
+    Ten K-steps from the D-step of the distillation problem's plain H∞ controller
+    (Skogestad & Postlethwaite 2005, Table 8.1):
+
+    >>> import numpy as np
+    >>> from lmi_suspension import hinfsyn, lft, mussv, freqresp
+    >>> from lmi_suspension.examples import skogestad_distillation
+    >>> from lmi_suspension.synthesis import HinfsynOptions
+    >>> ex, w = skogestad_distillation(), np.logspace(-3, 3, 61)
+    >>> opts = HinfsynOptions(riccati_search="bisection")
+    >>> K1 = hinfsyn(ex.P, 2, 2, method="riccati", options=opts).K
+    >>> mu = mussv(freqresp(lft(ex.P, K1), w), ex.blk)
+    >>> kstep = lambda PD: hinfsyn(PD, 2, 2, method="riccati", options=opts).K
+    >>> found = search_dscales(ex.P, 2, 2, [(1, 1), (1, 1), (2, 2)], w, mu.d_blocks,
+    ...                        np.ones(w.size), 2, kstep, max_evals=10)
+    >>> found.evaluations <= 10 and found.gamma <= found.gamma_start < mu.peak
+    True
+    """
+    t0 = time.perf_counter()
+    d_blocks = np.asarray(d_blocks, dtype=float)
+    free = [i for i in range(d_blocks.shape[0]) if not np.allclose(d_blocks[i], 1.0, rtol=1e-12)]
+    if not free or order < 1 or max_evals < 1:
+        return None
+    starts = [_fit_sequence(omega, d_blocks[i], weights, order)[-1] for i in free]
+    omega0 = [o for _, o in starts]
+    theta0 = np.concatenate([t for t, _ in starts])
+    size = theta0.size // len(free)
+    one = control.ss([], [], [], [[1.0]])
+    evals = [0]
+    best: dict = {}
+
+    def scalings(theta):
+        fits = [one] * d_blocks.shape[0]
+        for j, i in enumerate(free):
+            fits[i] = _to_statespace(theta[j * size:(j + 1) * size], order, omega0[j])
+        orders = tuple((f.nstates,) for f in fits)
+        return DScaleFit(tuple(fits), orders, (0.0,) * len(fits), omega, "search", True)
+
+    def gamma(theta) -> float:
+        evals[0] += 1
+        try:
+            dfit = scalings(theta)
+            PD = scaled_plant(P, nmeas, ncon, dfit, block_sizes)
+            K = kstep(PD)
+            value = float(hinfnorm(lft(PD, K, nmeas, ncon))[0])
+        except (LmiSuspensionError, ValueError, np.linalg.LinAlgError) as exc:
+            logger.debug("D-scale search: point failed (%s)", exc)
+            return np.inf
+        if np.isfinite(value) and value < best.get("gamma", np.inf):
+            best.update(gamma=value, K=K, dfit=dfit, theta=np.array(theta))
+            logger.info("D-scale search: gamma %.5f after %d K-steps", value, evals[0])
+            if value < target:
+                raise _Reached
+        return value
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # slycot's balancing notes, one per point
+        try:
+            gamma_start = gamma(theta0)
+        except _Reached:
+            gamma_start = best["gamma"]
+        if not np.isfinite(gamma_start):
+            return None
+        theta, level = theta0, gamma_start
+        # restarts: a fresh simplex around the best point escapes Nelder-Mead's collapse
+        while evals[0] < max_evals and level >= target:
+            try:
+                scipy.optimize.minimize(gamma, theta, method="Nelder-Mead",
+                                        options=dict(maxfev=max_evals - evals[0],
+                                                     xatol=1e-4, fatol=1e-6 * level))
+            except _Reached:
+                break
+            gained = level - best["gamma"]
+            theta, level = best["theta"], best["gamma"]
+            if gained <= _RESTART_RTOL * level:
+                break
+    return DScaleSearchResult(K=best["K"], gamma=best["gamma"], gamma_start=gamma_start,
+                              dfit=best["dfit"], evaluations=evals[0],
+                              seconds=time.perf_counter() - t0)
