@@ -304,7 +304,8 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     tok = stage("mu_design", "µ design (D-K iteration) ...")
 
     def on_iteration(rec):
-        say(f"  D-K iteration {rec.index}: gamma = {rec.gamma:.4f}, µ upper = "
+        what = "D-K iteration" if rec.stage == "dk" else "D-scale search, record"
+        say(f"  {what} {rec.index}: gamma = {rec.gamma:.4f}, µ upper = "
             f"{rec.mu_peak:.4f}, µ lower = {rec.mu_lower_peak:.4f} "
             f"({rec.seconds_k + rec.seconds_d + rec.seconds_fit:.1f} s)")
 
