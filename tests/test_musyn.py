@@ -43,10 +43,11 @@ def test_distillation_reaches_below_one(distillation_design):
     (bisection Riccati K-step, over-relaxed D-scales) gives 1.1798, 1.0344, 1.0272,
     1.0211, 1.0164, 1.0123 (the book's script: ... 1.0023 at iteration 6, 0.9998 at 7) and
     settles near 1.003 when run on; the direct D-scale search after the loop then goes
-    below 1, MATLAB's level.  Independent references on both sides: the search's γ,
-    certified on its own scaled plant, bounds µ at every frequency (so the dense-grid
-    peak may not exceed it), and no controller can beat the µ-optimal 0.9737 of the
-    book's optimal scalings by much (µ = its upper bound for these three blocks).
+    below 1, MATLAB's level.  Certificates: the search's γ, certified on its own scaled
+    plant, bounds µ at every frequency (so the dense-grid peak may not exceed it), and
+    the dense-grid lower bound (an explicit destabilising Δ) meets the upper one.  The
+    book's µ-optimal third-order scalings give 0.9740; with fourth-order scalings the
+    search got below that (0.9693 from the third iterate, 0.9759 from the tenth, measured).
     """
     ex, res, _ = distillation_design
     assert res.history[0].mu_peak == pytest.approx(PUBLISHED_MU_ITER1, rel=0.005)
@@ -56,12 +57,11 @@ def test_distillation_reaches_below_one(distillation_design):
     search = res.history[-1]
     assert search.stage == "dscale_search" and res.best_iteration == search.index
     assert search.gamma < search.gamma_prev  # below the γ of its starting scalings
-    assert res.mu_peak < 1.0  # 0.98 measured
+    assert res.mu_peak < 1.0  # 0.97-0.98 measured
     # (the dense grid reaches 1e-9 rad/s, where the loop's double-precision response is
     # off by ~2e-4: at 1.4e-7 rad/s µ was 0.99034 from it and 0.99017 from a 40-digit
     # evaluation, against γ = 0.98990 from hinfnorm, measured)
     assert res.mu_peak <= search.gamma * (1 + 1e-3)
-    assert res.mu_peak > 0.99 * LUNDSTROM_MU
     # lower <= upper everywhere, and for three complex full blocks µ's upper bound is
     # tight, so the two bounds agree closely at the peak (independent certificate).
     assert np.all(res.mu.lower <= res.mu.upper * (1 + 1e-9))

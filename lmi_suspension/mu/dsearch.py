@@ -8,7 +8,9 @@ stage minimises what D-K minimises alternately, ``γ(θ) = min_K ‖D_θ F_l(P, 
 over the parameters ``θ`` of the rational fits themselves (poles, zeros and gain of each
 scaling, in the stable minimum-phase parametrisation of :mod:`.dfit`), by Nelder-Mead
 with restarts.  Every value is a certified closed-loop norm, so the controller it
-returns has ``µ <= γ`` at every frequency.
+returns has ``µ <= γ`` at every frequency.  On distillation, 100 K-steps from the third
+D-K iterate certify 0.9694 (µ 0.9693, upper = lower bound): fourth-order scalings do
+better than the book's third-order optimum.
 """
 
 from __future__ import annotations
@@ -33,6 +35,13 @@ logger = logging.getLogger(__name__)
 
 #: a Nelder-Mead round that gains less than this (relative) ends the search
 _RESTART_RTOL = 1e-4
+#: blocks whose optimal scalings agree this closely at every frequency share one fit
+_TIE_RTOL = 1e-3
+#: edge of the initial simplex in the log-parameters (a factor e^0.5 ≈ 1.65 on each
+#: pole or zero frequency, damping and the gain).  scipy's default (5 % of each value,
+#: 2.5e-4 for values near 0) stalled at µ 0.9919 on distillation from the tenth D-K
+#: iterate, against 0.9799 with edge 0.1, 0.9759 with 0.3 (measured, 100 K-steps)
+_SIMPLEX_STEP = 0.5
 
 
 @dataclass(frozen=True)
@@ -61,6 +70,21 @@ class DScaleSearchResult:
     dfit: DScaleFit
     evaluations: int
     seconds: float
+
+
+def _equal_scalings(d_blocks: np.ndarray, free: list[int], rtol: float = _TIE_RTOL
+                    ) -> list[list[int]]:
+    """Free blocks grouped by equal optimal scalings (within ``rtol`` at every
+    frequency); each group is searched as one function."""
+    groups: list[list[int]] = []
+    for i in free:
+        for g in groups:
+            if np.allclose(d_blocks[i], d_blocks[g[0]], rtol=rtol, atol=0.0):
+                g.append(i)
+                break
+        else:
+            groups.append([i])
+    return groups
 
 
 class _Reached(Exception):
@@ -126,18 +150,21 @@ def search_dscales(P, nmeas: int, ncon: int, block_sizes, omega, d_blocks, weigh
     free = [i for i in range(d_blocks.shape[0]) if not np.allclose(d_blocks[i], 1.0, rtol=1e-12)]
     if not free or order < 1 or max_evals < 1:
         return None
-    starts = [_fit_sequence(omega, d_blocks[i], weights, order)[-1] for i in free]
+    groups = _equal_scalings(d_blocks, free)
+    starts = [_fit_sequence(omega, d_blocks[g[0]], weights, order)[-1] for g in groups]
     omega0 = [o for _, o in starts]
     theta0 = np.concatenate([t for t, _ in starts])
-    size = theta0.size // len(free)
+    size = theta0.size // len(groups)
     one = control.ss([], [], [], [[1.0]])
     evals = [0]
     best: dict = {}
 
     def scalings(theta):
         fits = [one] * d_blocks.shape[0]
-        for j, i in enumerate(free):
-            fits[i] = _to_statespace(theta[j * size:(j + 1) * size], order, omega0[j])
+        for j, group in enumerate(groups):
+            d = _to_statespace(theta[j * size:(j + 1) * size], order, omega0[j])
+            for i in group:
+                fits[i] = d
         orders = tuple((f.nstates,) for f in fits)
         return DScaleFit(tuple(fits), orders, (0.0,) * len(fits), omega, "search", True)
 
@@ -170,9 +197,11 @@ def search_dscales(P, nmeas: int, ncon: int, block_sizes, omega, d_blocks, weigh
         # restarts: a fresh simplex around the best point escapes Nelder-Mead's collapse
         while evals[0] < max_evals and level >= target:
             try:
+                simplex = np.vstack([theta, theta + _SIMPLEX_STEP * np.eye(theta.size)])
                 scipy.optimize.minimize(gamma, theta, method="Nelder-Mead",
                                         options=dict(maxfev=max_evals - evals[0],
-                                                     xatol=1e-4, fatol=1e-6 * level))
+                                                     initial_simplex=simplex, xatol=1e-4,
+                                                     fatol=1e-6 * level))
             except _Reached:
                 break
             gained = level - best["gamma"]
