@@ -119,10 +119,10 @@ class MusynOptions:
         the search certifies 0.969, below the 0.974 of the book's optimal third-order
         scalings).  Blocks whose optimal scalings coincide share one fit.  The
         controller is kept only if its µ peak beats the best iterate's; ``0`` turns the
-        search off.  Skipped for repeated-scalar blocks, constant scalings and once
-        ``mu_target`` is
-        met; it stops as soon as its certified γ (a bound of µ at every frequency) is
-        below ``mu_target``.
+        search off.  Skipped for constant scalings (``max_dfit_order = 0``) and once
+        ``mu_target`` is met; it stops as soon as its certified γ (a bound of µ at every
+        frequency) is below ``mu_target``.  Repeated-scalar blocks are searched with
+        scalings ``d(s) I``, a restriction of their D matrices (still a valid bound).
     """
 
     max_iter: int = 8
@@ -631,8 +631,8 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
 
     d_blocks, upper = dstep
     d_blocks = np.asarray(d_blocks)
-    if d_blocks.ndim != 2 or d_blocks.dtype == object or int(opts.max_dfit_order) < 1:
-        return None  # repeated-scalar D matrices, or constant scalings requested
+    if d_blocks.ndim != 2 or int(opts.max_dfit_order) < 1:
+        return None  # per-block magnitudes expected; constant scalings requested
     options = (opts.hinfsyn_options if opts.hinfsyn_options is not None
                else HinfsynOptions(riccati_search="bisection"))
 

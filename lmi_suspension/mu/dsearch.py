@@ -109,8 +109,8 @@ def search_dscales(P, nmeas: int, ncon: int, block_sizes, omega, d_blocks, weigh
     d_blocks : ndarray, shape (n_blocks, n_freq)
         Scalar D magnitudes per block (the starting point, fitted at ``order``); a block
         equal to 1 everywhere (the normalised one) stays 1.
-    weights : ndarray
-        Weights of the starting fit.
+    weights : ndarray or None
+        Weights of the starting fit (None: uniform).
     order : int
         Order of every searched scaling (>= 1).
     kstep : callable
@@ -150,6 +150,7 @@ def search_dscales(P, nmeas: int, ncon: int, block_sizes, omega, d_blocks, weigh
     free = [i for i in range(d_blocks.shape[0]) if not np.allclose(d_blocks[i], 1.0, rtol=1e-12)]
     if not free or order < 1 or max_evals < 1:
         return None
+    weights = np.ones(omega.size) if weights is None else np.asarray(weights, dtype=float)
     groups = _equal_scalings(d_blocks, free)
     starts = [_fit_sequence(omega, d_blocks[g[0]], weights, order)[-1] for g in groups]
     omega0 = [o for _, o in starts]
@@ -175,7 +176,7 @@ def search_dscales(P, nmeas: int, ncon: int, block_sizes, omega, d_blocks, weigh
             PD = scaled_plant(P, nmeas, ncon, dfit, block_sizes)
             K = kstep(PD)
             value = float(hinfnorm(lft(PD, K, nmeas, ncon))[0])
-        except (LmiSuspensionError, ValueError, np.linalg.LinAlgError) as exc:
+        except (LmiSuspensionError, ValueError, ArithmeticError, np.linalg.LinAlgError) as exc:
             logger.debug("D-scale search: point failed (%s)", exc)
             return np.inf
         if np.isfinite(value) and value < best.get("gamma", np.inf):
