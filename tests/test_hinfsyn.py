@@ -276,13 +276,17 @@ def test_polish_after_an_inaccurate_gamma_minimisation():
     aug = seat_augmented_plant(replace(weights, include_delay=False,
                                        include_parametric=False, include_paper=False))
     P = GeneralizedPlant.from_statespace(aug.P, aug.nmeas, aug.ncon)
+    # 2026-11-23 (later): the inaccurate scaled route is now followed by a retry on the
+    # unscaled plant, whose γ minimisation is accurate here (certified 0.84578 against
+    # its optimum 0.84567, measured); the scaled route's polish still runs first.
     lmi = hinfsyn(P, P.ny, P.nu)
     assert_certified(lmi, P)
-    assert any("polish probe" in w for w in lmi.warnings)
+    assert any(w.startswith("scaled route: polish probe") for w in lmi.warnings)
+    assert any(w.startswith("solved without plant scaling") for w in lmi.warnings)
     ric = hinfsyn(P, P.ny, P.nu, method="riccati", options=HinfsynOptions(riccati_scale=True))
     reference = hinfnorm(lft(P, ric.K))[0]
     assert lmi.gamma <= reference * 1.005
-    assert lmi.gamma < lmi.gamma_lower  # the γ minimisation really was inaccurate here
+    assert lmi.gamma_lower <= lmi.gamma <= lmi.gamma_lower * 1.005
 
 
 def test_riccati_probes_recover_a_destabilising_python_control_controller():
@@ -366,7 +370,7 @@ def test_lmi_on_a_plant_scaled_by_a_three_decade_dscale():
     plant spans poles from 1e-6 to 1e3 rad/s.  Riccati (certified here, bisection
     search) reaches 1.619; the LMI route certified 8324 (measured 2026-11-23: its γ
     minimisation stops against the trace bound at every xy_bound up to 1e9, with and
-    without plant scaling).  The µ-optimal scalings of this problem roll off the same
+    without plant scaling), and 1.880 since the unscaled retry.  The µ-optimal scalings of this problem roll off the same
     way, which is why musyn's K-step falls back on Riccati variants there."""
     from lmi_suspension.examples import skogestad_distillation
     from lmi_suspension.mu.dfit import fit_dscales, scaled_plant
@@ -383,3 +387,29 @@ def test_lmi_on_a_plant_scaled_by_a_three_decade_dscale():
     lmi = hinfsyn(PD, ex.nmeas, ex.ncon, method="lmi", options=HinfsynOptions(polish_steps=0))
     assert_certified(lmi, PD)
     assert lmi.gamma <= ric.gamma * 1.005
+
+
+def test_unscaled_retry_when_the_scaled_gamma_minimisation_is_off():
+    """Distillation problem (S&P 2005, Sec. 8.12.4) with its uncertainty channels scaled
+    by ``(0.3 s + 1)/(s + 1)``: the input/output normalisation leaves the scaled γ
+    minimisation at 6.49 (measured) while the problem's optimum is 1.166; the retry on the
+    unscaled plant finds it.  Reference: Riccati (bisection search), certified here."""
+    from lmi_suspension.examples import skogestad_distillation
+    from lmi_suspension.mu.dfit import fit_dscales, scaled_plant
+
+    ex = skogestad_distillation()
+    w = np.logspace(-3, 3, 61)
+    d = np.abs(control.tf([0.3, 1], [1, 1])(1j * w))
+    fit = fit_dscales(w, [d, d, np.ones_like(w)], order=1)
+    PD = scaled_plant(ex.P, ex.nmeas, ex.ncon, fit, [(1, 1), (1, 1), (2, 2)])
+    ric = hinfsyn(PD, ex.nmeas, ex.ncon, method="riccati",
+                  options=HinfsynOptions(riccati_search="bisection"))
+    lmi = hinfsyn(PD, ex.nmeas, ex.ncon, options=HinfsynOptions(polish_steps=0))
+    assert_certified(lmi, PD)
+    assert any(w.startswith("solved without plant scaling") for w in lmi.warnings)
+    assert any(w.startswith("scaled route: ") for w in lmi.warnings)
+    assert lmi.gamma <= ric.gamma * 1.005  # 1.1661 both, measured
+    # without the retry (scale=False from the start it is not needed) the same optimum
+    plain = hinfsyn(PD, ex.nmeas, ex.ncon, options=HinfsynOptions(polish_steps=0, scale=False))
+    assert not any(w.startswith("solved without") for w in plain.warnings)
+    assert plain.gamma == pytest.approx(lmi.gamma, rel=5e-3)

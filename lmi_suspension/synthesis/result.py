@@ -51,7 +51,11 @@ class HinfsynOptions:
         Number of recovery attempts (tightened tolerances, relaxed γ) after an
         inaccurate or failed solve.
     scale : bool
-        Balance states and normalise inputs/outputs before solving.
+        Balance states and normalise inputs/outputs before solving.  With ``gamma=None``,
+        when the scaled γ minimisation ends against its trace bound or a controller
+        certifies below its optimum, the unscaled plant is solved as well (trace bound
+        ``100 xy_bound``) and the better certified controller kept; its warnings then
+        include the scaled route's, prefixed ``"scaled route: "``.
     cert_rtol : float
         Relative tolerance above which a disagreement between the certified γ and the
         solver's own bound is reported in ``warnings``.
