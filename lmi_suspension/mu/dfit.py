@@ -423,7 +423,8 @@ class DScaleFit:
     omega : numpy.ndarray
         The frequency grid (rad/s).
     criterion : str
-        ``"rtol"`` (log-magnitude error) or ``"mu_check"``.
+        ``"rtol"`` (log-magnitude error), ``"mu_check"``, or ``"search"`` for scalings
+        found by :func:`~lmi_suspension.mu.search_dscales` (``errors`` are then 0).
     met : bool
         Whether the criterion was met within ``max_order``; if not, the best fit found
         is returned (and a warning is logged).
