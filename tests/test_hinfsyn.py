@@ -362,6 +362,24 @@ def test_gamma_abort_stops_the_lmi_route_above_a_known_level():
     assert res.gamma == pytest.approx(scalar_gamma_opt(1.0), rel=5e-3)
 
 
+def _distillation_with_dscale(a):
+    """S&P (2005) Sec. 8.12.4 distillation plant with both uncertainty channels scaled by
+    ``d(s) = (a s + 1)/(s + 1)``, and its Riccati controller (bisection search),
+    certified: ``(PD, nmeas, ncon, riccati_result)``."""
+    from lmi_suspension.examples import skogestad_distillation
+    from lmi_suspension.mu.dfit import fit_dscales, scaled_plant
+
+    ex = skogestad_distillation()
+    w = np.logspace(-3, 3, 61)
+    d = np.abs(control.tf([a, 1], [1, 1])(1j * w))
+    fit = fit_dscales(w, [d, d, np.ones_like(w)], order=1)
+    PD = scaled_plant(ex.P, ex.nmeas, ex.ncon, fit, [(1, 1), (1, 1), (2, 2)])
+    ric = hinfsyn(PD, ex.nmeas, ex.ncon, method="riccati",
+                  options=HinfsynOptions(riccati_search="bisection"))
+    assert_certified(ric, PD)
+    return PD, ex.nmeas, ex.ncon, ric
+
+
 @pytest.mark.xfail(strict=True, reason="known defect (issue #3): the LMI route fails on "
                    "plants whose D-scaling rolls off over three decades")
 def test_lmi_on_a_plant_scaled_by_a_three_decade_dscale():
@@ -370,21 +388,12 @@ def test_lmi_on_a_plant_scaled_by_a_three_decade_dscale():
     plant spans poles from 1e-6 to 1e3 rad/s.  Riccati (certified here, bisection
     search) reaches 1.619; the LMI route certified 8324 (measured 2026-11-23: its γ
     minimisation stops against the trace bound at every xy_bound up to 1e9, with and
-    without plant scaling), and 1.880 since the unscaled retry.  The µ-optimal scalings of this problem roll off the same
-    way, which is why musyn's K-step falls back on Riccati variants there."""
-    from lmi_suspension.examples import skogestad_distillation
-    from lmi_suspension.mu.dfit import fit_dscales, scaled_plant
-
-    ex = skogestad_distillation()
-    w = np.logspace(-3, 3, 61)
-    d = np.abs(control.tf([0.001, 1], [1, 1])(1j * w))
-    fit = fit_dscales(w, [d, d, np.ones_like(w)], order=1)
-    PD = scaled_plant(ex.P, ex.nmeas, ex.ncon, fit, [(1, 1), (1, 1), (2, 2)])
-    ric = hinfsyn(PD, ex.nmeas, ex.ncon, method="riccati",
-                  options=HinfsynOptions(riccati_search="bisection"))
-    assert_certified(ric, PD)
+    without plant scaling), and 1.880 since the unscaled retry.  The µ-optimal scalings
+    of this problem roll off the same way, which is why musyn's K-step falls back on
+    Riccati variants there."""
+    PD, nmeas, ncon, ric = _distillation_with_dscale(0.001)
     assert ric.gamma < 1.7  # 1.619 measured
-    lmi = hinfsyn(PD, ex.nmeas, ex.ncon, method="lmi", options=HinfsynOptions(polish_steps=0))
+    lmi = hinfsyn(PD, nmeas, ncon, method="lmi", options=HinfsynOptions(polish_steps=0))
     assert_certified(lmi, PD)
     assert lmi.gamma <= ric.gamma * 1.005
 
@@ -394,22 +403,13 @@ def test_unscaled_retry_when_the_scaled_gamma_minimisation_is_off():
     by ``(0.3 s + 1)/(s + 1)``: the input/output normalisation leaves the scaled γ
     minimisation at 6.49 (measured) while the problem's optimum is 1.166; the retry on the
     unscaled plant finds it.  Reference: Riccati (bisection search), certified here."""
-    from lmi_suspension.examples import skogestad_distillation
-    from lmi_suspension.mu.dfit import fit_dscales, scaled_plant
-
-    ex = skogestad_distillation()
-    w = np.logspace(-3, 3, 61)
-    d = np.abs(control.tf([0.3, 1], [1, 1])(1j * w))
-    fit = fit_dscales(w, [d, d, np.ones_like(w)], order=1)
-    PD = scaled_plant(ex.P, ex.nmeas, ex.ncon, fit, [(1, 1), (1, 1), (2, 2)])
-    ric = hinfsyn(PD, ex.nmeas, ex.ncon, method="riccati",
-                  options=HinfsynOptions(riccati_search="bisection"))
-    lmi = hinfsyn(PD, ex.nmeas, ex.ncon, options=HinfsynOptions(polish_steps=0))
+    PD, nmeas, ncon, ric = _distillation_with_dscale(0.3)
+    lmi = hinfsyn(PD, nmeas, ncon, options=HinfsynOptions(polish_steps=0))
     assert_certified(lmi, PD)
     assert any(w.startswith("solved without plant scaling") for w in lmi.warnings)
     assert any(w.startswith("scaled route: ") for w in lmi.warnings)
     assert lmi.gamma <= ric.gamma * 1.005  # 1.1661 both, measured
     # without the retry (scale=False from the start it is not needed) the same optimum
-    plain = hinfsyn(PD, ex.nmeas, ex.ncon, options=HinfsynOptions(polish_steps=0, scale=False))
+    plain = hinfsyn(PD, nmeas, ncon, options=HinfsynOptions(polish_steps=0, scale=False))
     assert not any(w.startswith("solved without") for w in plain.warnings)
     assert plain.gamma == pytest.approx(lmi.gamma, rel=5e-3)
