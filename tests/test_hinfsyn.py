@@ -334,6 +334,34 @@ def test_riccati_bisection_search_against_the_lmi_and_the_book():
         HinfsynOptions(riccati_search="scan")
 
 
+def test_riccati_bracket_starts_the_search_and_is_widened_where_wrong():
+    """The distillation plain H∞ problem (γ ≈ 1.18, S&P 2005 Sec. 8.12.4): a bracket
+    around the optimum needs fewer levels than the search from γ = 1; brackets entirely
+    above or below it are widened; every start ends at the same certified γ (the
+    search's own resolution is riccati_rtol = 0.1 %)."""
+    from lmi_suspension.examples import skogestad_distillation
+
+    ex = skogestad_distillation()
+
+    def search(bracket):
+        res = hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati",
+                      options=HinfsynOptions(riccati_search="bisection",
+                                             riccati_bracket=bracket))
+        assert_certified(res, ex.P)
+        note = next(w for w in res.warnings if w.startswith("riccati bisection"))
+        return res.gamma, int(note.split()[2])  # "riccati bisection: N levels, ..."
+
+    g0, n0 = search(None)
+    g1, n1 = search((0.97 * 1.18, 1.03 * 1.18))
+    assert n1 < n0
+    for bracket in ((1.5, 2.0), (0.2, 0.5)):
+        assert search(bracket)[0] == pytest.approx(g0, rel=2e-3)
+    assert g1 == pytest.approx(g0, rel=2e-3)
+    for bad in ((1.0,), (2.0, 1.0), (0.0, 1.0), (1.0, float("inf"))):
+        with pytest.raises(ParameterError, match="riccati_bracket"):
+            HinfsynOptions(riccati_bracket=bad)
+
+
 def test_riccati_at_a_fixed_gamma():
     # Skogestad & Postlethwaite (2005), Sec. 8.12.4: the plain H∞ problem of the
     # distillation example has γ_opt ≈ 1.18 (their first D-K iteration), so a

@@ -9,7 +9,7 @@ over the parameters ``θ`` of the rational fits themselves (poles, zeros and gai
 scaling, in the stable minimum-phase parametrisation of :mod:`.dfit`), by Nelder-Mead
 with restarts.  Every value is a certified closed-loop norm, so the controller it
 returns has ``µ <= γ`` at every frequency.  On distillation, 100 K-steps from the third
-D-K iterate certify 0.9694 (µ 0.9693, upper = lower bound): fourth-order scalings do
+D-K iterate certify µ 0.968 (upper = lower bound): fourth-order scalings do
 better than the book's third-order optimum.
 """
 

@@ -277,20 +277,21 @@ def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warni
             best = (gamma, K)
         return True
 
-    lo, hi = 0.0, 1.0
+    lo, hi = (0.0, 1.0) if opts.riccati_bracket is None else map(float, opts.riccati_bracket)
+    lo_unachieved = False
     for _ in range(_RICCATI_BRACKET_STEPS):
         if achieved(hi):
             break
-        lo, hi = hi, 4.0 * hi
+        lo, hi, lo_unachieved = hi, 4.0 * hi, True
     else:
         raise InfeasibleError(f"Riccati H∞ synthesis found no stabilising controller for "
                               f"any level up to {hi:.3g}")
-    if lo == 0.0:  # achieved at 1: walk down to an unachieved level
+    if not lo_unachieved:  # hi achieved at once: walk down to an unachieved level
+        lo = lo if lo > 0 else hi / 4.0
         for _ in range(_RICCATI_BRACKET_STEPS):
-            if not achieved(hi / 4.0):
-                lo = hi / 4.0
+            if not achieved(lo):
                 break
-            hi /= 4.0
+            lo, hi = lo / 4.0, lo
         else:
             lo = 0.0
     steps = 0

@@ -79,6 +79,11 @@ class HinfsynOptions:
         :func:`~lmi_suspension.mu.musyn`).
     riccati_rtol : float
         Relative width at which the ``"bisection"`` search stops.
+    riccati_bracket : tuple of float or None
+        ``"bisection"`` only: levels ``(lo, hi)`` to start the search from, when a γ is
+        roughly known (the D-scale search of :func:`~lmi_suspension.mu.musyn` passes
+        ±3 % around its last one); both ends are checked and widened by factors of 4
+        where wrong.  ``None``: start from γ = 1.
     gamma_abort : float or None
         ``method="lmi"`` only: raise :class:`~lmi_suspension.errors.SolverError` as soon as
         the γ minimisation's optimum exceeds this level (a γ another controller is
@@ -122,6 +127,7 @@ class HinfsynOptions:
     riccati_probes: tuple = ()
     riccati_search: str = "python-control"
     riccati_rtol: float = 1e-3
+    riccati_bracket: tuple | None = None
     gamma_abort: float | None = None
     tighten_rtol: float = 1e-3
     polish_steps: int = 4
@@ -140,6 +146,13 @@ class HinfsynOptions:
         if self.riccati_search not in ("python-control", "bisection"):
             raise ParameterError("riccati_search must be 'python-control' or 'bisection', "
                                  f"got {self.riccati_search!r}")
+        if self.riccati_bracket is not None:
+            try:
+                lo, hi = (float(x) for x in self.riccati_bracket)
+            except (TypeError, ValueError) as exc:
+                raise ParameterError("riccati_bracket must be a pair (lo, hi)") from exc
+            if not (np.isfinite(hi) and 0 < lo < hi):
+                raise ParameterError(f"riccati_bracket needs 0 < lo < hi, got {self.riccati_bracket!r}")
         if self.direct_solve_method not in ("faer", "qdldl"):
             raise ParameterError("direct_solve_method must be 'faer' or 'qdldl', got "
                                  f"{self.direct_solve_method!r}")
