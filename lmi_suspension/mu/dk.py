@@ -633,8 +633,11 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
     d_blocks = np.asarray(d_blocks)
     if d_blocks.ndim != 2 or int(opts.max_dfit_order) < 1:
         return None  # per-block magnitudes expected; constant scalings requested
-    options = (opts.hinfsyn_options if opts.hinfsyn_options is not None
-               else HinfsynOptions(riccati_search="bisection"))
+    # the bisection search (its bracket follows the search) at free γ, whatever the
+    # loop's K-steps were given
+    options = replace(opts.hinfsyn_options if opts.hinfsyn_options is not None
+                      else HinfsynOptions(), riccati_search="bisection", gamma=None,
+                      riccati_probes=())
 
     level = {}  # the last point's γ: neighbouring points have similar ones
 
