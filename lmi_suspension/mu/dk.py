@@ -639,17 +639,18 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
                       else HinfsynOptions(), riccati_search="bisection", gamma=None,
                       riccati_probes=())
 
-    level = {}  # the last point's γ: neighbouring points have similar ones
+    last = None  # the last point's γ level: neighbouring points have similar ones
 
     def kstep(PD):
+        nonlocal last
         # Riccati on a Gramian-balanced realization: the variant that finds the optimum
         # on these plants (tests: the book's optimal scalings) at ~0.1 s per point
         plant = _gramian_balanced(PD)
-        here = options if "gamma" not in level else replace(
-            options, riccati_bracket=(0.97 * level["gamma"], 1.03 * level["gamma"]))
+        here = options if last is None else replace(
+            options, riccati_bracket=(0.97 * last, 1.03 * last))
         res = hinfsyn(PD if plant is None else plant, nmeas, ncon, method="riccati",
                       options=here)
-        level["gamma"] = res.gamma_solver
+        last = res.gamma_solver
         return res.K
 
     t0 = time.perf_counter()

@@ -53,6 +53,8 @@ _INFEASIBLE = (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE)
 #: the bounded-real inequality at a relaxed γ only has a margin of the order of the
 #: relaxation to give (measured on COMPleib AC3, AC4, AC6: 1 fails where 0.1 succeeds)
 _BRL_SLACK_WEIGHT = 0.1
+#: how the warning of an active trace bound in the γ minimisation begins
+TRACE_BOUND_ACTIVE = "the bound trace(X) + trace(Y)"
 
 
 @dataclass(frozen=True)
@@ -181,7 +183,7 @@ def gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None = N
     gval = float(g.value) if gamma is None else float(gamma)
     Rv, Sv = _sym(R.value), _sym(S.value)
     if np.trace(Rv) + np.trace(Sv) > 0.99 * opts.xy_bound * n:
-        warnings.append(f"the bound trace(X) + trace(Y) <= {opts.xy_bound:g} n is active; "
+        warnings.append(f"{TRACE_BOUND_ACTIVE} <= {opts.xy_bound:g} n is active; "
                         "the LMI optimum may be above the true infimum")
     return LmiSolution(gval, Rv, Sv, str(status), tuple(warnings))
 
