@@ -94,6 +94,78 @@ def test_timings_book_every_solve_as_reconstruction(monkeypatch):
     assert res.timings.reconstruct >= 0.2
 
 
+def test_a_failed_unscaled_retry_is_said_and_booked(monkeypatch):
+    """The unscaled retry runs after a suspect scaled route; when it fails, the scaled
+    route's controller is returned, a warning says so and the retry's time is booked
+    under ``solve`` (it was dropped: a 301 s call at 40 states reported 36 s, measured).
+    Here the seat plant of the polish test with the regularisation that makes its scaled
+    route suspect, and a retry that sleeps 0.3 s and raises."""
+    import importlib
+    import time
+    from dataclasses import replace
+
+    from lmi_suspension.errors import SolverError
+    from lmi_suspension.seat.augmented import seat_augmented_plant
+    from lmi_suspension.seat.design import DEFAULT_DESIGN
+
+    module = importlib.import_module("lmi_suspension.synthesis.hinfsyn")
+
+    weights = replace(DEFAULT_DESIGN, acc_ref=3.0, u_max=3000.0, z_max=0.10,
+                      noise=(5e-4, 5e-4), w_scale=0.65, w_corner=6.5, w_rolloff=None)
+    aug = seat_augmented_plant(replace(weights, include_delay=False,
+                                       include_parametric=False, include_paper=False))
+    P = GeneralizedPlant.from_statespace(aug.P, aug.nmeas, aug.ncon)
+    real = module._hinfsyn_lmi
+
+    def failing_retry(G, opts, t0):
+        if not opts.scale:
+            time.sleep(0.3)
+            raise SolverError("forced failure of the retry")
+        return real(G, opts, t0)
+
+    monkeypatch.setattr(module, "_hinfsyn_lmi", failing_retry)
+    res = hinfsyn(P, P.ny, P.nu, options=HinfsynOptions(static_regularization=1e-8))
+    assert_certified(res, P)
+    assert any(w.startswith("unscaled retry failed: forced failure") for w in res.warnings)
+    assert res.timings.solve >= 0.3
+
+
+@pytest.mark.parametrize("singular", [False, True])
+def test_sparse_projection_is_the_projected_inequality(singular):
+    """The γ minimisation's sparse form (_Projection: rotated null-space basis and state
+    coordinates) is the textbook projected inequality W_Rᵀ M(R) W_R of Gahinet & Apkarian
+    (1994, Thm 4.3) up to an orthogonal congruence: same eigenvalues, for any R and γ.
+    The reference is computed here with numpy from scipy's null-space basis; the
+    singular case has D12 = 0 on one control (the state part of the basis then loses
+    rank)."""
+    import cvxpy as cp
+    import scipy.linalg
+
+    from lmi_suspension.synthesis.lmi import _Projection
+
+    rng = np.random.default_rng(11)
+    n, nw, nu, nz = 5, 2, 2, 3
+    A, B1, B2 = (rng.standard_normal(s) for s in ((n, n), (n, nw), (n, nu)))
+    C1, D11, D12 = (rng.standard_normal(s) for s in ((nz, n), (nz, nw), (nz, nu)))
+    if singular:
+        D12[:, 1] = 0.0
+    proj = _Projection.build(A, B2, C1, D12, B1, D11)
+    R = rng.standard_normal((n, n))
+    R, gamma = R + R.T, 1.7
+    N = scipy.linalg.null_space(np.hstack([B2.T, D12.T]))
+    W = scipy.linalg.block_diag(N, np.eye(nw))
+    M = np.block([[A @ R + R @ A.T, R @ C1.T, B1],
+                  [C1 @ R, -gamma * np.eye(nz), D11],
+                  [B1.T, D11.T, -gamma * np.eye(nw)]])
+    reference = np.linalg.eigvalsh(W.T @ M @ W)
+    Rt = cp.Variable((n, n), symmetric=True)
+    Rt.value = proj.T.T @ R @ proj.T
+    L = proj.matrix(Rt, gamma).value
+    assert np.array_equal(L, L.T)  # symmetric by construction
+    np.testing.assert_allclose(np.linalg.eigvalsh(L), reference, atol=1e-10)
+    assert proj.s.size == (n - 1 if singular else n)
+
+
 def test_d22_loop_shifting_keeps_gamma():
     # γ_opt does not depend on D22 (u -> u shifted by a static feedback)
     rng = np.random.default_rng(3)
