@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import logging
 import warnings as warnings_module
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import control
 import cvxpy as cp
@@ -106,15 +106,22 @@ class _Projection:
     s: np.ndarray
     Q: np.ndarray
     H: np.ndarray
+    #: the dense form's state part of the basis (``E = F R N_x``, ``T = I``), else None
+    Nx: np.ndarray | None = None
 
     @classmethod
-    def build(cls, A, B2, C1, D12, B1, D11) -> "_Projection | None":
+    def build(cls, A, B2, C1, D12, B1, D11, sparse: bool = True) -> "_Projection | None":
         """For ``ker [B2ᵀ D12ᵀ]`` (the ``S`` inequality passes the dual data); None when
-        the null space is empty (nothing to constrain)."""
+        the null space is empty (nothing to constrain).  ``sparse=False`` gives the
+        plain form: any orthonormal basis, ``T = I``."""
         n = A.shape[0]
         N = _null(np.hstack([B2.T, D12.T]))
         if not N.shape[1]:
             return None
+        if not sparse:
+            Nx, Nz = N[:n], N[n:]
+            return cls(np.eye(n), Nx.T @ A + Nz.T @ C1, np.ones(0), Nz.T @ Nz,
+                       Nx.T @ B1 + Nz.T @ D11, Nx)
         U, sv, Vt = np.linalg.svd(N[:n])
         r = int(np.sum(sv > 1e-10))  # sv <= 1: N is orthonormal
         N = N @ Vt.T
@@ -132,22 +139,25 @@ class _Projection:
     def matrix(self, Rt, gamma):
         """The projected bounded-real matrix (affine CVXPY expression in ``R̃`` and γ)."""
         k, r = self.F.shape[0], self.s.size
-        # multiply (not @ diag(s)): CVXPY keeps a dense factor's zeros as coefficients
-        E = cp.multiply(self.F @ Rt[:, :r], self.s[None, :])
-        if k > r:
-            E = cp.hstack([E, np.zeros((k, k - r))])
+        if self.Nx is not None:
+            E = self.F @ Rt @ self.Nx
+        else:
+            # multiply (not @ diag(s)): CVXPY keeps a dense factor's zeros as coefficients
+            E = cp.multiply(self.F @ Rt[:, :r], self.s[None, :])
+            if k > r:
+                E = cp.hstack([E, np.zeros((k, k - r))])
         nw = self.H.shape[1]
         return _sym(cp.bmat([[E + E.T - gamma * self.Q, self.H],
                              [self.H.T, -gamma * np.eye(nw)]]))
 
 
-def _projections(P: GeneralizedPlant):
+def _projections(P: GeneralizedPlant, sparse: bool = True):
     """The ``R`` and ``S`` inequalities' projections (``D22 = 0``)."""
     b = P.blocks()
     A, B1, B2, C1, C2 = b["A"], b["B1"], b["B2"], b["C1"], b["C2"]
     D11, D12, D21 = b["D11"], b["D12"], b["D21"]
-    return (_Projection.build(A, B2, C1, D12, B1, D11),
-            _Projection.build(A.T, C2.T, B1.T, D21.T, C1.T, D11.T))
+    return (_Projection.build(A, B2, C1, D12, B1, D11, sparse),
+            _Projection.build(A.T, C2.T, B1.T, D21.T, C1.T, D11.T, sparse))
 
 
 def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
@@ -197,21 +207,36 @@ def gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None = N
               ) -> LmiSolution:
     """Minimise γ over the elimination LMIs (or test feasibility at fixed ``gamma``).
 
-    ``P`` must have ``D22 = 0`` and should be scaled.
+    ``P`` must have ``D22 = 0`` and should be scaled.  The sparse form
+    (:class:`_Projection`) is solved first; where Clarabel fails on it, the plain form.
 
     Raises
     ------
     InfeasibleError
         If no controller achieves the fixed ``gamma`` (or none stabilises ``P``).
     SolverError
-        If Clarabel fails after ``opts.max_recoveries`` recoveries.
+        If Clarabel fails after ``opts.max_recoveries`` recoveries on both forms.
     """
+    try:
+        return _gamma_lmi(P, opts, gamma, sparse=True)
+    except SolverError as exc:
+        # a D-scaled distillation plant (D12 = 0.002) gave null-space bases whose state
+        # parts have singular values from 7e-6 to 1: Clarabel's first KKT factorisation
+        # failed on the sparse form and not on the plain one (measured 2026-11-24)
+        logger.info("gamma_lmi: sparse form failed (%s); plain form", exc)
+        sol = _gamma_lmi(P, opts, gamma, sparse=False)
+        return replace(sol, warnings=(f"sparse form failed ({exc}); solved in the plain "
+                                      "form",) + sol.warnings)
+
+
+def _gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None,
+               sparse: bool) -> LmiSolution:
     n = P.nstates
     # R̃, S̃: the Lyapunov variables in the rotated coordinates of their projections
     Rt = cp.Variable((n, n), symmetric=True)
     St = cp.Variable((n, n), symmetric=True)
     g = cp.Variable(nonneg=True) if gamma is None else float(gamma)
-    proj_r, proj_s = _projections(P)
+    proj_r, proj_s = _projections(P, sparse)
     cons = [p.lmi(V, g, opts.margin) for p, V in ((proj_r, Rt), (proj_s, St)) if p is not None]
     # [[R, I], [I, S]] >= 0 with R = T_R R̃ T_Rᵀ, S = T_S S̃ T_Sᵀ, by the orthogonal
     # congruence diag(T_R, T_S): same eigenvalues, coupling block T_Rᵀ T_S
