@@ -163,8 +163,9 @@ def _projections(P: GeneralizedPlant, sparse: bool = True):
 def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
     """Solve with explicit Clarabel settings; recover from inaccurate/failed solves.
 
-    Each recovery loosens the tolerances tenfold, doubles the iteration bound and
-    raises the static regularisation; every recovery is recorded in ``warnings``.
+    Each recovery loosens the tolerances tenfold, doubles the iteration bound, raises
+    the static regularisation and refines every KKT solve iteratively; every recovery
+    is recorded in ``warnings``.
     """
     settings = opts.clarabel_settings()
     attempts = [settings]
@@ -175,7 +176,8 @@ def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
                   reduced_tol_gap_rel=min(1e-2, settings["reduced_tol_gap_rel"] * f),
                   reduced_tol_gap_abs=min(1e-2, settings["reduced_tol_gap_abs"] * f),
                   reduced_tol_feas=min(1e-4, settings["reduced_tol_feas"] * f),
-                  max_iter=int(settings["max_iter"]) * 2, static_regularization_constant=1e-7)
+                  max_iter=int(settings["max_iter"]) * 2, static_regularization_constant=1e-7,
+                  iterative_refinement_enable=True)
         attempts.append(kw)
     status = None
     for k, kw in enumerate(attempts):
@@ -436,7 +438,10 @@ class ControllerLmi:
         self.gamma.value = float(gamma)
         self.trace_bound.value = float(trace_bound)
         warnings: list[str] = []
-        status = _solve(self.problem, opts, f"controller LMI at gamma={gamma:.6g}", warnings)
+        # refined KKT solves: the controller is built from this point, so it must be
+        # accurate (see HinfsynOptions.refine_gamma_minimisation)
+        status = _solve(self.problem, replace(opts, refine_gamma_minimisation=True),
+                        f"controller LMI at gamma={gamma:.6g}", warnings)
         t = self.t.value
         if status in _INFEASIBLE or t is None or t <= 0.0:
             raise InfeasibleError(
