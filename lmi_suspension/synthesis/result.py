@@ -52,8 +52,8 @@ class HinfsynOptions:
         inaccurate or failed solve.
     scale : bool
         Balance states and normalise inputs/outputs before solving.  With ``gamma=None``,
-        when the scaled γ minimisation ends against its trace bound or a controller
-        certifies below its optimum, the unscaled plant is solved as well (trace bound
+        when a controller certifies below the scaled γ minimisation's optimum (by more
+        than ``gamma_relax``), the unscaled plant is solved as well (trace bound
         ``100 xy_bound``) and the better certified controller kept; its warnings then
         include the scaled route's, prefixed ``"scaled route: "``.
     cert_rtol : float
