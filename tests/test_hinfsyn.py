@@ -560,9 +560,10 @@ def test_lmi_on_a_plant_scaled_by_a_three_decade_dscale():
     plant spans poles from 1e-6 to 1e3 rad/s.  Riccati (certified here, bisection
     search) reaches 1.619; the LMI route certified 8324 (measured 2026-11-23: its γ
     minimisation stops against the trace bound at every xy_bound up to 1e9, with and
-    without plant scaling), 12.1 with the unscaled retry, and 17.2 on 2026-11-24 (sparse
-    γ minimisation: it fails on the scaled plant, whose plain form is then solved, and
-    the unscaled retry's stops at 697).  The µ-optimal scalings
+    without plant scaling), 12.1 with the unscaled retry, and 1.917 on 2026-11-24 (the
+    sparse γ minimisation fails on this plant and its plain form is solved; the unscaled
+    retry's minimisation stops at 364, far above, and its controller certifies 1.917).
+    The µ-optimal scalings
     of this problem roll off the same way, which is why musyn's K-step falls back on
     Riccati variants there."""
     PD, nmeas, ncon, ric = _distillation_with_dscale(0.001)
