@@ -94,7 +94,7 @@ class _Projection:
     eigenvalues, so margins mean what they meant; but each entry of ``E`` now depends on
     one column of ``R̃`` instead of on all of ``R``, and Clarabel's KKT system has 6
     times fewer nonzeros: the γ minimisation of the 22-state benchmark plant took 0.80 s
-    instead of 1.12 s (19 and 20 iterations), and HE1 of COMPleib, where the dense form
+    instead of 1.12 s (19 and 20 iterations, both with iterative refinement), and HE1 of COMPleib, where the dense form
     stopped 0.3 % short, is solved to 0.07 %.  (A basis with ``N_x = [I, 0]`` keeps the
     coupling ``[[R, I], [I, S]]`` sparse and was faster still, 0.57 s, but it is not
     orthonormal and lost the optimum of a D-scaled distillation plant: 1.31 against
