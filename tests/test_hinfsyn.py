@@ -95,6 +95,21 @@ def test_timings_book_every_solve_as_reconstruction(monkeypatch):
     assert res.timings.reconstruct >= 0.2
 
 
+def _nominal_seat_plant():
+    """Nominal seat plant (paper's Fig. 2 without the delay and uncertainty channels)
+    with the comfort weights of the 2026-11-22 design, pinned (see the polish test)."""
+    from dataclasses import replace
+
+    from lmi_suspension.seat.augmented import seat_augmented_plant
+    from lmi_suspension.seat.design import DEFAULT_DESIGN
+
+    weights = replace(DEFAULT_DESIGN, acc_ref=3.0, u_max=3000.0, z_max=0.10,
+                      noise=(5e-4, 5e-4), w_scale=0.65, w_corner=6.5, w_rolloff=None)
+    aug = seat_augmented_plant(replace(weights, include_delay=False,
+                                       include_parametric=False, include_paper=False))
+    return GeneralizedPlant.from_statespace(aug.P, aug.nmeas, aug.ncon)
+
+
 def test_a_failed_unscaled_retry_is_said_and_booked(monkeypatch):
     """The unscaled retry runs after a suspect scaled route; when it fails, the scaled
     route's controller is returned, a warning says so and the retry's time is booked
@@ -103,18 +118,9 @@ def test_a_failed_unscaled_retry_is_said_and_booked(monkeypatch):
     route suspect, and a retry that sleeps 0.3 s and raises."""
     import importlib
     import time
-    from dataclasses import replace
-
-    from lmi_suspension.seat.augmented import seat_augmented_plant
-    from lmi_suspension.seat.design import DEFAULT_DESIGN
 
     module = importlib.import_module("lmi_suspension.synthesis.hinfsyn")
-
-    weights = replace(DEFAULT_DESIGN, acc_ref=3.0, u_max=3000.0, z_max=0.10,
-                      noise=(5e-4, 5e-4), w_scale=0.65, w_corner=6.5, w_rolloff=None)
-    aug = seat_augmented_plant(replace(weights, include_delay=False,
-                                       include_parametric=False, include_paper=False))
-    P = GeneralizedPlant.from_statespace(aug.P, aug.nmeas, aug.ncon)
+    P = _nominal_seat_plant()
     real = module._hinfsyn_lmi
 
     def failing_retry(G, opts, t0):
@@ -404,16 +410,7 @@ def test_polish_after_an_inaccurate_gamma_minimisation():
     # solved accurately and never reaches the polish.) The force/stroke scales and the
     # noise of that design are pinned here, so that a change of DEFAULT_DESIGN leaves
     # this plant as it was (2026-11-23: the default moved to 7000 N, 0.114 m, 1.7/0.1 mm).
-    from dataclasses import replace
-
-    from lmi_suspension.seat.augmented import seat_augmented_plant
-    from lmi_suspension.seat.design import DEFAULT_DESIGN
-
-    weights = replace(DEFAULT_DESIGN, acc_ref=3.0, u_max=3000.0, z_max=0.10,
-                      noise=(5e-4, 5e-4), w_scale=0.65, w_corner=6.5, w_rolloff=None)
-    aug = seat_augmented_plant(replace(weights, include_delay=False,
-                                       include_parametric=False, include_paper=False))
-    P = GeneralizedPlant.from_statespace(aug.P, aug.nmeas, aug.ncon)
+    P = _nominal_seat_plant()
     # 2026-11-23 (later): the inaccurate scaled route is now followed by a retry on the
     # unscaled plant, whose γ minimisation is accurate here (certified 0.84578 against
     # its optimum 0.84567, measured); the scaled route's polish still runs first.

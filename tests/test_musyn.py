@@ -375,7 +375,7 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
 
     def kstep(PD):
         calls.append(PD.nstates)
-        return _riccati_balanced(hinfsyn, PD, ex.nmeas, ex.ncon, bisection)[0]
+        return _riccati_balanced(hinfsyn, PD, ex.nmeas, ex.ncon, bisection).K
 
     found = search_dscales(ex.P, ex.nmeas, ex.ncon, [(1, 1), (1, 1), (2, 2)], w,
                            mu1.d_blocks, 0.2 + mu1.upper / mu1.upper.max(), 4, kstep,

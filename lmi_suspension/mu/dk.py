@@ -649,11 +649,9 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
             options, riccati_bracket=(0.97 * last, 1.03 * last))
         found = _riccati_balanced(hinfsyn, PD, nmeas, ncon, here)
         if found is None:
-            res = hinfsyn(PD, nmeas, ncon, method="riccati", options=here)
-            last = res.gamma_solver
-            return res.K
-        last = found[2].gamma_solver
-        return found[0]
+            found = hinfsyn(PD, nmeas, ncon, method="riccati", options=here)
+        last = found.gamma_solver
+        return found.K
 
     t0 = time.perf_counter()
     found = search_dscales(G.sys, nmeas, ncon, _block_sizes(struct), omega, d_blocks,
@@ -713,33 +711,40 @@ _BALANCED_LEVELS = (0.0, 3e-4, 1e-3, 3e-3)
 def _riccati_balanced(hinfsyn, PD, nmeas: int, ncon: int, options):
     """Riccati on a Gramian-balanced realization of ``PD``, judged on ``PD`` itself.
 
-    Returns ``(K, gamma, res)``: the controller, its certified γ on ``PD`` and the
-    balanced realization's :class:`HinfsynResult`; None when there is no balanced
-    realization.  The bisection's own choice is certified on the balanced realization,
-    which can be off near DC where the scaled plant has poles near 1e-6 rad/s: with the
-    book's optimal D-scales, the controller at the lowest achieved level certifies
-    0.97401 on ``PD`` but 1.0034 on the realization, and the bisection returned one
-    certifying 0.97688 on ``PD`` (measured 2026-11-24; the same code gave 0.97395 the
-    day before).  So the controllers at a few levels just above that level are
-    certified on ``PD`` too (SLICOT's suboptimal formulas, ``sb10ad`` job 4: a few
-    milliseconds each) and the best one is kept.
+    Returns the balanced realization's :class:`HinfsynResult` with the controller kept,
+    its certified γ, closed loop and poles on ``PD`` (``gamma_solver`` stays SLICOT's
+    lowest achieved level); None when there is no balanced realization.  The
+    bisection's own choice is certified on the balanced realization, which can be off
+    near DC where the scaled plant has poles near 1e-6 rad/s: with the book's optimal
+    D-scales, the controller at the lowest achieved level certifies 0.97401 on ``PD``
+    but 1.0034 on the realization, and the bisection returned one certifying 0.97688
+    on ``PD`` (measured 2026-11-24; the same code gave 0.97395 the day before).  So the
+    controllers at a few levels just above that level are certified on ``PD`` too
+    (SLICOT's suboptimal formulas, ``sb10ad`` job 4: a few milliseconds each) and the
+    best one is kept.
     """
     plant = _gramian_balanced(PD)
     if plant is None:
         return None
     res = hinfsyn(plant, nmeas, ncon, method="riccati", options=options)
-    best = (float(hinfnorm(lft(PD, res.K, nmeas, ncon))[0]), res.K)
+    candidates = [res.K]
     if options.gamma is None:
         for r in _BALANCED_LEVELS:
             try:
-                K = hinfsyn(plant, nmeas, ncon, method="riccati", options=replace(
-                    options, gamma=res.gamma_solver * (1.0 + r), riccati_probes=())).K
+                candidates.append(hinfsyn(plant, nmeas, ncon, method="riccati", options=replace(
+                    options, gamma=res.gamma_solver * (1.0 + r), riccati_probes=())).K)
             except LmiSuspensionError:
                 continue
-            gamma = float(hinfnorm(lft(PD, K, nmeas, ncon))[0])
-            if gamma < best[0]:
-                best = (gamma, K)
-    return best[1], best[0], res
+    loops = [(lft(PD, K, nmeas, ncon), K) for K in candidates]
+    gammas = [float(hinfnorm(CL)[0]) for CL, _ in loops]
+    best = int(np.argmin(gammas))
+    (CL, K), gamma = loops[best], gammas[best]
+    return replace(res, K=K, gamma=gamma, CL=CL, poles=np.linalg.eigvals(np.asarray(CL.A)),
+                   controller_fastest_pole=(float(np.max(np.abs(np.linalg.eigvals(K.A))))
+                                            if K.nstates else 0.0),
+                   warnings=res.warnings + (
+                       "Riccati on a Gramian-balanced realization of the scaled plant; "
+                       f"certified {gamma:.6g} on the plant itself",))
 
 
 def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
@@ -775,16 +780,7 @@ def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
                 errors.append(exc)
                 continue
             if found is not None:
-                K, gamma, res = found
-                CL = lft(PD, K, nmeas, ncon)
-                results.append(replace(
-                    res, K=K, gamma=gamma, CL=balanced_statespace(CL),
-                    poles=np.linalg.eigvals(np.asarray(CL.A)),
-                    controller_fastest_pole=(float(np.max(np.abs(np.linalg.eigvals(K.A))))
-                                             if K.nstates else 0.0),
-                    warnings=res.warnings + (
-                        "Riccati on a Gramian-balanced realization of the scaled plant; "
-                        f"certified {gamma:.6g} on the plant itself",)))
+                results.append(found)
             continue
         if method == "lmi" and results and PD.nstates > _LMI_FALLBACK_MAX_STATES:
             # measured: 29 s at 30 states, 191 s at 40, and gigabytes of KKT data

@@ -107,9 +107,9 @@ class HinfsynOptions:
         as fast as ``"qdldl"`` on the dense KKT systems of these SDPs) or ``"qdldl"``.
     max_threads : int
         Threads of Clarabel's ``"faer"`` factorisation; 0 lets Clarabel choose.  One is
-        the default: on this project's 2-core machines it was 25-30 % faster than the
-        automatic choice (22-state benchmark plant: 7.5-7.8 s against 10.3-10.4 s, same
-        γ; ``/tmp`` measurement of 2026-11-23 recorded in BENCHMARKS.md).
+        the default: on this project's 2-core machines it was the fastest (γ
+        minimisation of the 22-state benchmark plant: 1.18 s on one thread, 1.25 s on
+        two, 1.23 s automatic; measured 2026-11-24, recorded in BENCHMARKS.md).
     refine_gamma_minimisation : bool
         Clarabel's iterative refinement of each KKT solve in the γ minimisation (the
         controller LMI always refines, and so does every recovery).  Off by default: on
