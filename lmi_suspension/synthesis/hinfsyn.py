@@ -23,9 +23,9 @@ __all__ = ["hinfsyn"]
 
 logger = logging.getLogger(__name__)
 
-#: the γ minimisation is repeated once when the scaled optimum lies outside this range,
-#: so the solver works with γ near 1
-_GAMMA_RANGE = (1.0 / 16.0, 16.0)
+#: each failed reconstruction relaxes the level above the LMI optimum by this factor
+#: more (gamma_relax, 4 gamma_relax, 16 gamma_relax, ...)
+_RELAX_GROWTH = 4.0
 #: factors of 4 from γ = 1 in each direction (4**40 ≈ 1e24) before the bracket search gives up
 _RICCATI_BRACKET_STEPS = 40
 #: bound on the halvings of the bracket (a 4x bracket is 1e-3 wide after about 11)
@@ -145,48 +145,7 @@ def hinfsyn(P, nmeas: int, ncon: int, *, method: str = "lmi",
     check_stabilizable(scale_plant(G)[0])
     if method == "riccati":
         return _hinfsyn_riccati(G, opts, t0)
-    res = _hinfsyn_lmi(G, opts, t0)
-    if opts.scale and opts.gamma is None and _suspect(res, opts):
-        # The input/output normalisation can leave the γ minimisation against its trace
-        # bound far above the optimum (D-scaled distillation plants: 2.40 where the
-        # unscaled plant gives 1.4943 and Riccati 1.4949, measured); retry unscaled with
-        # a wider bound and keep the better certified controller.
-        t_retry = time.perf_counter()
-        try:
-            alt = _hinfsyn_lmi(G, replace(opts, scale=False, xy_bound=opts.xy_bound * 100),
-                               t_retry)
-        except LmiSuspensionError as exc:
-            logger.info("hinfsyn: unscaled retry failed (%s)", exc)
-            # its time is solver time too (unbooked, it hid 265 s of a 301 s call at
-            # 40 states)
-            res = replace(res, warnings=res.warnings + (f"unscaled retry failed: {exc}",),
-                          timings=replace(res.timings, solve=res.timings.solve
-                                          + time.perf_counter() - t_retry))
-        else:
-            # both attempts' solver time is booked under solve
-            if alt.gamma < res.gamma:
-                res = replace(alt, warnings=alt.warnings + (
-                    f"solved without plant scaling: the scaled route certified {res.gamma:.6g}, "
-                    "below its own γ minimisation's optimum",) + tuple(
-                    f"scaled route: {w}" for w in res.warnings),
-                    timings=replace(alt.timings, solve=alt.timings.solve + res.timings.total))
-            else:
-                res = replace(res, timings=replace(res.timings,
-                                                   solve=res.timings.solve + alt.timings.total))
-    return res
-
-
-def _suspect(res: HinfsynResult, opts: HinfsynOptions) -> bool:
-    """Whether the scaled γ minimisation stopped above the optimum, as proved by a
-    controller that certifies below it by more than the relaxation (the condition of
-    the polish)."""
-    # Neither an 'optimal_inaccurate' solve nor an active trace bound alone is enough:
-    # on random 16- and 30-state plants a retry on either doubled or tripled the time
-    # for no gain (30 states: 26 s instead of 7 s, measured 2026-11-24), while every
-    # D-scaled distillation plant where the retry helped (d = (a s + 1)/(s + 1),
-    # a = 0.3 ... 0.001, and COMPleib AC4) had its scaled route beaten by its controller.
-    return (res.gamma_lower is not None and res.gamma_lower > 0.0
-            and res.gamma < res.gamma_lower * (1.0 - opts.gamma_relax))
+    return _hinfsyn_lmi(G, opts, t0)
 
 
 # --------------------------------------------------------------------------- riccati
@@ -321,125 +280,52 @@ def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warni
 
 
 # --------------------------------------------------------------------------- lmi
-def _probe(G: GeneralizedPlant, sc: PlantScaling, used: tuple, g_try: float,
-           opts: HinfsynOptions):
-    """Re-solve the (already compiled) controller LMI at ``g_try`` and certify.
+def _reconstruct(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling,
+                 sol: "_lmi.LmiSolution", g_base: float, fixed: bool,
+                 opts: HinfsynOptions, warnings: list):
+    """The controller LMI in the frame of ``sol`` at ``(1 + r) g_base`` (scaled units),
+    ``r = gamma_relax, 4 gamma_relax, 16 gamma_relax, ...``, until a controller
+    certifies at its level (at a fixed γ the trace box grows tenfold instead).
 
-    Returns ``(result tuple or None, description, warnings)``; ``None`` when the solve
-    fails or the closed loop is unstable; ``warnings`` are the solve's and the
-    certificate's, for the caller to keep when it keeps the result."""
-    lmi_k, trace_bound = used
-    probe_warn: list[str] = []
-    try:
-        Ks, cond_xy, status, cwarn = lmi_k.controller(g_try * sc.gamma_factor, trace_bound,
-                                                      opts)
-        K = _undo_loop_shift(sc.controller_to_original(Ks), G.D22)
-        tc = time.perf_counter()  # the certificate's own time (the solve is reconstruction)
-        CL, gamma, poles = _certify(G, K, g_try, opts, probe_warn, "lmi")
-    except (InfeasibleError, SolverError, np.linalg.LinAlgError) as exc:
-        return None, str(exc), []
-    if not np.isfinite(gamma):
-        return None, "; ".join(probe_warn), []
-    return ((K, CL, gamma, poles, g_try, status, cond_xy, float("nan"),
-             time.perf_counter() - tc), f"certified {gamma:.6g}", list(cwarn) + probe_warn)
-
-
-def _polish(G: GeneralizedPlant, sc: PlantScaling, used: tuple, result: tuple,
-            opts: HinfsynOptions, warnings: list) -> tuple:
-    """Probe lower levels after an inaccurate γ minimisation.
-
-    The interior-point γ minimisation can stop above the infimum while reporting
-    "optimal" (measured on the seat plant: 1.2752 against 1.2434 achieved by a certified
-    Riccati controller).  When a controller certifies below that optimum, the controller
-    LMI that produced it (already compiled) is re-solved at ``1 - step`` times the best
-    certified level, at most ``polish_steps`` times, starting from ``polish_step`` and
-    halving the step after every probe that does not certify lower.
+    Returns ``(K, CL, gamma, poles, level, status, cond_xy, t_certify)`` with ``level``
+    in the plant's units; raises :class:`SolverError` (or, at a fixed γ,
+    :class:`InfeasibleError`) when every attempt fails.
     """
-    step = opts.polish_step
-    for k in range(int(opts.polish_steps)):
-        best = result[2]
-        g_try = best * (1.0 - step)
-        probe, why, probe_warn = _probe(G, sc, used, g_try, opts)
-        if probe is None or not probe[2] < best:
-            # below the infimum, or too close to it for the solver: halve the step
-            warnings.append(f"polish probe {k + 1} at gamma={g_try:.6g}: {why}")
-            step /= 2.0
-            continue
-        warnings.append(f"polish probe {k + 1}: certified {probe[2]:.6g} (was {best:.6g})")
-        warnings += probe_warn
-        result = probe
-    return result
-
-
-def _tighten(G: GeneralizedPlant, sc: PlantScaling, used: tuple, result: tuple,
-             g_try: float, opts: HinfsynOptions, warnings: list) -> tuple:
-    """The tightening level ``g_try`` again, in a trace box 1000 times wider than the one
-    that gave ``result`` (nearer the optimum X and Y grow), after it failed in the
-    default box; kept only if it certifies lower."""
-    lmi_k, trace_bound = used
-    probe, why, probe_warn = _probe(G, sc, (lmi_k, trace_bound * 1000.0), g_try, opts)
-    if probe is not None and probe[2] < result[2]:
-        warnings.append(f"tightened: certified {probe[2]:.6g} at gamma={g_try:.6g} "
-                        f"(was {result[2]:.6g})")
-        warnings.extend(probe_warn)
-        return probe
-    warnings.append(f"tightening at gamma={g_try:.6g} kept the first controller: {why}")
-    return result
-
-
-class _ReconstructionFrames:
-    """State coordinates in which the controller LMI is tried, built on first use.
-
-    Even attempts use the coordinates that balance the γ-optimal ``(R, S)``
-    (:func:`~lmi_suspension.synthesis.lmi.balancing_transform`): they rescue plants whose
-    Lyapunov matrices span many decades.  Odd attempts use the scaled plant as it is:
-    when the γ minimisation itself was inaccurate (``R``, ``S`` far from optimal,
-    COMPleib AC4), the balancing built from them can be the worse choice.
-    """
-
-    def __init__(self, Ps: GeneralizedPlant, R: np.ndarray, S: np.ndarray):
-        self._Ps, self._R, self._S = Ps, R, S
-        self._built: dict[int, tuple] = {}
-
-    def get(self, attempt: int) -> tuple[str, "_lmi.ControllerLmi", float]:
-        """``(name, controller LMI, trace(X) + trace(Y) of the γ-optimum there)``."""
-        k = attempt % 2
-        if k not in self._built:
-            if k == 0:
-                T, sigma = _lmi.balancing_transform(self._R, self._S)
-                self._built[k] = ("balanced", _lmi.ControllerLmi(transform_states(self._Ps, T)),
-                                  2.0 * float(np.sum(sigma)))
+    n = Ps.nstates
+    lmi_k = _lmi.ControllerLmi(Ps, _lmi.Frame.from_lyapunov(sol.R, sol.S)) if n else None
+    t_cert = 0.0
+    last = None
+    for attempt in range(int(opts.max_recoveries) + 1):
+        relax = 0.0 if fixed else opts.gamma_relax * _RELAX_GROWTH ** attempt
+        g_ctrl = g_base * (1.0 + relax)
+        box = opts.center_trace * 2 * n * (10.0 ** attempt if fixed else 1.0)
+        try:
+            if n == 0:
+                center = _lmi.LmiSolution(g_ctrl, np.zeros((0, 0)), np.zeros((0, 0)), "static")
+                Ks, cond_xy, _cond_lyap = _lmi.explicit_controller(Ps, center, g_ctrl)
+                status, cwarn = "static", ()
             else:
-                self._built[k] = ("scaled", _lmi.ControllerLmi(self._Ps),
-                                  float(np.trace(self._R) + np.trace(self._S)))
-        return self._built[k]
-
-
-def _resolve_near_one(sol: "_lmi.LmiSolution", Ps: GeneralizedPlant, sc: PlantScaling,
-                      opts: HinfsynOptions):
-    """Re-solve the γ minimisation with the errors scaled so that the solver sees γ near 1,
-    and keep whichever of the two minimisations went lower.
-
-    Scaling the errors by ``1/f`` maps a solution ``(γ, R, S)`` to ``(γ/f, f R, S/f)``,
-    so the first one stays a candidate (on the 16-state benchmark plant the re-solve
-    needed a recovery and stopped at 3.3287 where the first solve had reached 3.3164,
-    measured 2026-11-24).  Returns ``(solution, plant, scaling)`` in the new scaling.
-    """
-    Ps2, sc2 = sc.with_error_scale(Ps, sol.gamma)
-    f = sc2.cz / sc.cz
-    first = replace(sol, gamma=sol.gamma / f, R=sol.R * f, S=sol.S / f)
-    try:
-        second = _lmi.gamma_lmi(Ps2, opts)
-    except SolverError as exc:
-        return replace(first, warnings=first.warnings + (
-            f"the γ minimisation re-solved with γ scaled to 1 failed ({exc}); "
-            "the first minimisation is used",)), Ps2, sc2
-    if first.gamma < second.gamma:
-        return replace(first, warnings=first.warnings + (
-            f"the γ minimisation re-solved with γ scaled to 1 stopped higher "
-            f"({second.gamma / sc2.gamma_factor:.6g}); the first minimisation is used",)), \
-            Ps2, sc2
-    return second, Ps2, sc2
+                Ks, cond_xy, status, cwarn = lmi_k.controller(g_ctrl, box, opts)
+            K = _undo_loop_shift(sc.controller_to_original(Ks), G.D22)
+        except (InfeasibleError, SolverError, np.linalg.LinAlgError) as exc:
+            last = exc
+            warnings.append(f"reconstruction at gamma={g_ctrl / sc.gamma_factor:.6g} "
+                            f"failed ({exc})")
+            continue
+        tc = time.perf_counter()
+        cert_warn: list[str] = []
+        level = g_ctrl / sc.gamma_factor
+        CL, gamma, poles = _certify(G, K, level, opts, cert_warn, "lmi")
+        t_cert += time.perf_counter() - tc
+        if np.isfinite(gamma) and not cert_warn:
+            warnings.extend(cwarn)
+            return K, CL, gamma, poles, level, status, cond_xy, t_cert
+        last = "; ".join(cert_warn)
+        warnings.append(f"reconstruction at gamma={level:.6g}: {last}")
+    if fixed and isinstance(last, InfeasibleError):
+        raise last
+    raise SolverError(f"controller reconstruction failed after {opts.max_recoveries} "
+                      f"recoveries: {last}")
 
 
 def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> HinfsynResult:
@@ -451,121 +337,42 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
         Ps, sc = G0, PlantScaling(np.ones(G0.nstates), np.ones(G0.nu), np.ones(G0.ny), 1.0, 1.0)
     t_setup = time.perf_counter() - t0
     t1 = time.perf_counter()
-    if opts.gamma is None:
+    fixed = opts.gamma is not None
+    if not fixed:
         sol = _lmi.gamma_lmi(Ps, opts)
-        if sol.gamma > opts.gamma_atol and not _GAMMA_RANGE[0] <= sol.gamma <= _GAMMA_RANGE[1]:
-            sol, Ps, sc = _resolve_near_one(sol, Ps, sc, opts)
-        warnings += list(sol.warnings)
         gamma_lower: float | None = sol.gamma / sc.gamma_factor
         if opts.gamma_abort is not None and gamma_lower > opts.gamma_abort:
             raise SolverError(f"the γ minimisation stopped at {gamma_lower:.6g}, above the "
                               f"level {opts.gamma_abort:.6g} known to be achievable: the LMI "
                               "solve is inaccurate on this plant")
-        relax = opts.gamma_relax
-        tiny_optimum = sol.gamma <= opts.gamma_atol
-        if tiny_optimum:
+        if sol.gamma <= opts.gamma_atol:
             warnings.append(f"the LMI optimum is about 0 (below gamma_atol = {opts.gamma_atol:g} "
                             "in scaled units); designing for gamma_atol instead")
         # the target the reconstruction works towards, in scaled units
         g_base = max(sol.gamma, opts.gamma_atol)
     else:
-        gamma_lower, tiny_optimum = None, False
+        gamma_lower = None
         g_base = float(opts.gamma) * sc.gamma_factor
         sol = _lmi.gamma_lmi(Ps, opts, gamma=g_base)
-        warnings += list(sol.warnings)
-        relax = 0.0
-    R, S = sol.R, sol.S
+    warnings += list(sol.warnings)
     if g_base != 1.0:
-        # errors scaled by 1/f so the reconstruction sees gamma near 1; in the bounded-real
-        # inequality this maps S -> S / f and R -> f R
+        # errors scaled by 1/f (a power of two) so that the controller LMI sees γ near 1;
+        # in the bounded-real inequality this maps S -> S / f and R -> f R
         f = float(np.exp2(np.round(np.log2(g_base))))
         Ps, sc = sc.with_error_scale(Ps, g_base)
-        g_base, R, S = g_base / f, R * f, S / f
-    n = Ps.nstates
-    frames = _ReconstructionFrames(Ps, R, S) if n else None
+        g_base, sol = g_base / f, replace(sol, R=sol.R * f, S=sol.S / f)
     t_solve = time.perf_counter() - t1
 
     t2 = time.perf_counter()
-    result, used = None, None
-    tight = (opts.gamma is None and n > 0 and not tiny_optimum and opts.tighten_rtol > 0
-             and gamma_lower > 0.0)
-    if tight:
-        # The tightening level first, in the balanced frame with the box the tightening
-        # uses: where it certifies (most plants) the relaxed reconstruction is one
-        # controller-LMI solve saved (3.9 s of 14 s on the 22-state benchmark plant).
-        _frame, lmi_k, trace0 = frames.get(0)
-        box = opts.center_trace * trace0 * 10.0
-        g_tight = gamma_lower * (1.0 + 0.8 * opts.tighten_rtol)
-        probe, why, probe_warn = _probe(G, sc, (lmi_k, box), g_tight, opts)
-        if probe is not None and probe[2] <= g_tight * (1.0 + opts.cert_rtol):
-            result, used = probe, (lmi_k, box)
-            warnings.append(f"reconstructed at the tightening level {g_tight:.6g}: "
-                            f"certified {probe[2]:.6g}")
-            warnings.extend(probe_warn)
-        else:
-            warnings.append(f"reconstruction at the tightening level {g_tight:.6g} failed "
-                            f"({why}); relaxed reconstruction instead")
-    tight_failed = result is None
-    for attempt in range(int(opts.max_recoveries) + 1 if result is None else 0):
-        g_ctrl = g_base * (1.0 + relax)
-        try:
-            if n == 0:
-                center = _lmi.LmiSolution(g_ctrl, np.zeros((0, 0)), np.zeros((0, 0)), "static")
-                Ks, cond_xy, cond_lyap = _lmi.explicit_controller(Ps, center, g_ctrl)
-            else:
-                frame, lmi_k, trace0 = frames.get(attempt)
-                trace_bound = opts.center_trace * trace0 * 10.0 ** (attempt // 2)
-                Ks, cond_xy, cstatus, cwarn = lmi_k.controller(g_ctrl, trace_bound, opts)
-                center = _lmi.LmiSolution(g_ctrl, np.zeros((0, 0)), np.zeros((0, 0)),
-                                          cstatus, cwarn)
-                cond_lyap = float("nan")
-            K = _undo_loop_shift(sc.controller_to_original(Ks), G.D22)
-        except (InfeasibleError, SolverError, np.linalg.LinAlgError) as exc:
-            if attempt == opts.max_recoveries:
-                if opts.gamma is not None and isinstance(exc, InfeasibleError):
-                    raise
-                raise SolverError(f"controller reconstruction failed after "
-                                  f"{opts.max_recoveries} recoveries: {exc}") from exc
-            warnings.append(f"reconstruction attempt {attempt + 1} failed ({exc}); "
-                            "next: other state coordinates, larger trace bound, relaxed gamma")
-            if opts.gamma is None and attempt % 2:
-                relax *= 1.6
-            continue
-        warnings += list(center.warnings)
-        tc = time.perf_counter()
-        att_warn: list[str] = []
-        g_ctrl_orig = g_ctrl / sc.gamma_factor
-        CL, gamma, poles = _certify(G, K, g_ctrl_orig, opts, att_warn, "lmi")
-        t_cert = time.perf_counter() - tc
-        result = (K, CL, gamma, poles, g_ctrl_orig, center.status, cond_xy, cond_lyap, t_cert)
-        if np.isfinite(gamma) and not att_warn:
-            used = (lmi_k, trace_bound) if n else None
-            break
-        if attempt < opts.max_recoveries:
-            warnings.append(f"reconstruction attempt {attempt + 1}: {'; '.join(att_warn)}; "
-                            "next: other state coordinates, larger trace bound, relaxed gamma")
-            if opts.gamma is None and attempt % 2:
-                relax *= 1.6
-        else:
-            warnings += att_warn
-    if opts.gamma is None and gamma_lower is not None and used is not None \
-            and gamma_lower > 0.0 and not tiny_optimum \
-            and result[2] < gamma_lower * (1.0 - opts.gamma_relax):
-        # (below it by less than the relaxation, as the tightening level can certify when
-        # the minimisation was only "almost solved", the probes are not worth their cost:
-        # four failed 25 s solves on the 30-state benchmark plant, measured)
-        warnings.append(f"certified gamma {result[2]:.6g} is below the LMI optimum "
+    K, CL, gamma, poles, level, status, cond_xy, t_cert = _reconstruct(
+        G, Ps, sc, sol, g_base, fixed, opts, warnings)
+    if gamma_lower is not None and gamma < gamma_lower * (1.0 - opts.gamma_relax):
+        warnings.append(f"certified gamma {gamma:.6g} is below the LMI optimum "
                         f"{gamma_lower:.6g}: the γ minimisation was inaccurate")
-        result = _polish(G, sc, used, result, opts, warnings)
-    elif tight and tight_failed and used is not None \
-            and result[2] > gamma_lower * (1.0 + opts.tighten_rtol):
-        result = _tighten(G, sc, used, result, g_tight, opts, warnings)
-    K, CL, gamma, poles, g_ctrl, status, cond_xy, cond_lyap, t_cert = result
     t_rec = time.perf_counter() - t2 - t_cert
     return HinfsynResult(
-        K=K, CL=CL, gamma=gamma, gamma_solver=float(g_ctrl), gamma_lower=gamma_lower,
+        K=K, CL=CL, gamma=gamma, gamma_solver=float(level), gamma_lower=gamma_lower,
         poles=poles, status=status, method="lmi",
         timings=Timings(setup=t_setup, solve=t_solve, reconstruct=t_rec, certify=t_cert),
         warnings=tuple(warnings), controller_fastest_pole=_fastest_pole(K),
-        cond_xy=cond_xy, cond_lyap=cond_lyap)
-
+        cond_xy=cond_xy)

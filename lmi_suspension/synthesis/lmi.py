@@ -43,7 +43,7 @@ from ..lti.plant import GeneralizedPlant
 from .result import HinfsynOptions
 
 __all__ = ["gamma_lmi", "balancing_transform", "ControllerLmi", "explicit_controller",
-           "LmiSolution"]
+           "Frame", "LmiSolution"]
 
 logger = logging.getLogger(__name__)
 
@@ -55,6 +55,9 @@ _INFEASIBLE = (cp.INFEASIBLE, cp.INFEASIBLE_INACCURATE)
 #: the bounded-real inequality at a relaxed γ only has a margin of the order of the
 #: relaxation to give (measured on COMPleib AC3, AC4, AC6: 1 fails where 0.1 succeeds)
 _BRL_SLACK_WEIGHT = 0.1
+#: Clarabel's static regularisation in the controller LMI at least (see
+#: :meth:`ControllerLmi.controller`)
+_CONTROLLER_STATIC_REG = 1e-8
 #: how the warning of an active trace bound in the γ minimisation begins
 TRACE_BOUND_ACTIVE = "the bound trace(X) + trace(Y)"
 
@@ -78,6 +81,57 @@ def _null(M: np.ndarray) -> np.ndarray:
 
 def _sym(E):
     return (E + E.T) / 2
+
+
+@dataclass(frozen=True)
+class Frame:
+    """Coordinates and variable scalings in which an H∞ LMI is well conditioned.
+
+    From a preliminary solution ``(R, S)`` of the projected LMIs: the state coordinates
+    ``x = T x_b`` that balance it (``T⁻¹ R T⁻ᵀ = Tᵀ S T = diag(sigma)``,
+    :func:`balancing_transform`) and, in them, the Lyapunov variables written relative
+    to it, ``R_b = D R̂ D``, ``S_b = D Ŝ D`` with ``D = diag(sqrt(sigma))``.  Near that
+    solution ``R̂ ≈ Ŝ ≈ I``: every variable is of order one and every slack is relative,
+    whatever the decades between the plant's fast and slow modes.  Each inequality is
+    then the one of the plant in its own coordinates (``x_b = D x̂`` for the ``R``
+    inequality, ``x_b = D⁻¹ x̂`` for the ``S`` one) and the coupling reads
+    ``[[R̂, Σ⁻¹], [Σ⁻¹, Ŝ]] >= 0``.
+
+    Measured on COMPleib HE1 (2026-11-25): in the balanced coordinates alone
+    (``sigma`` 1 ... 1.8e4) the controller LMI's optimal slack at 0.08 % above the
+    optimum was +1.4e-3, -3.6e-3 or -1.6e-2 depending on Clarabel's static
+    regularisation (1e-10, 1e-8, 1e-7) and failed outright under OpenBLAS's SkylakeX
+    kernel; written relative to ``sigma`` it gave the same controller (certified
+    0.073648 at 0.05 % above the optimum) under every regularisation and kernel.
+    """
+
+    T: np.ndarray
+    sigma: np.ndarray
+
+    @classmethod
+    def identity(cls, n: int) -> "Frame":
+        return cls(np.eye(n), np.ones(n))
+
+    @classmethod
+    def from_lyapunov(cls, R: np.ndarray, S: np.ndarray) -> "Frame":
+        """The frame that balances ``(R, S)`` (see :func:`balancing_transform`)."""
+        T, sigma = balancing_transform(R, S)
+        return cls(T, sigma)
+
+    def plants(self, P: GeneralizedPlant):
+        """``P`` in the coordinates of the ``R`` and of the ``S`` inequality."""
+        from ..lti.scaling import transform_states
+
+        d = np.sqrt(self.sigma)
+        return (transform_states(P, self.T * d[None, :]),
+                transform_states(P, self.T / d[None, :]))
+
+    def lyapunov(self, Rh: np.ndarray, Sh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(R, S)`` of the plant's own coordinates from the relative ``(R̂, Ŝ)``."""
+        d = np.sqrt(self.sigma)
+        Rb, Sb = d[:, None] * Rh * d[None, :], d[:, None] * Sh * d[None, :]
+        Ti = np.linalg.inv(self.T)
+        return _sym(self.T @ Rb @ self.T.T), _sym(Ti.T @ Sb @ Ti)
 
 
 @dataclass(frozen=True)
@@ -205,12 +259,15 @@ def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
                       f"(last status {status!r})", status=str(status))
 
 
-def gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None = None
-              ) -> LmiSolution:
+def gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None = None,
+              frame: Frame | None = None) -> LmiSolution:
     """Minimise γ over the elimination LMIs (or test feasibility at fixed ``gamma``).
 
-    ``P`` must have ``D22 = 0`` and should be scaled.  The sparse form
-    (:class:`_Projection`) is solved first; where Clarabel fails on it, the plain form.
+    ``P`` must have ``D22 = 0`` and should be scaled.  With a ``frame`` (from an earlier
+    solution) the Lyapunov variables are written relative to it (:class:`Frame`); the
+    bound ``trace + trace <= xy_bound n`` then applies to the relative variables.  The
+    sparse form (:class:`_Projection`) is solved first; where Clarabel fails on it,
+    the plain form.  ``R`` and ``S`` are returned in the coordinates of ``P``.
 
     Raises
     ------
@@ -219,31 +276,33 @@ def gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None = N
     SolverError
         If Clarabel fails after ``opts.max_recoveries`` recoveries on both forms.
     """
+    frame = Frame.identity(P.nstates) if frame is None else frame
     try:
-        return _gamma_lmi(P, opts, gamma, sparse=True)
+        return _gamma_lmi(P, opts, gamma, frame, sparse=True)
     except SolverError as exc:
         # a D-scaled distillation plant (D12 = 0.002) gave null-space bases whose state
         # parts have singular values from 7e-6 to 1: Clarabel's first KKT factorisation
         # failed on the sparse form and not on the plain one (measured 2026-11-24)
         logger.info("gamma_lmi: sparse form failed (%s); plain form", exc)
-        sol = _gamma_lmi(P, opts, gamma, sparse=False)
+        sol = _gamma_lmi(P, opts, gamma, frame, sparse=False)
         return replace(sol, warnings=(f"sparse form failed ({exc}); solved in the plain "
                                       "form",) + sol.warnings)
 
 
 def _gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None,
-               sparse: bool) -> LmiSolution:
+               frame: Frame, sparse: bool) -> LmiSolution:
     n = P.nstates
-    # R̃, S̃: the Lyapunov variables in the rotated coordinates of their projections
+    # R̃, S̃: the relative Lyapunov variables in the rotated coordinates of their projections
     Rt = cp.Variable((n, n), symmetric=True)
     St = cp.Variable((n, n), symmetric=True)
     g = cp.Variable(nonneg=True) if gamma is None else float(gamma)
-    proj_r, proj_s = _projections(P, sparse)
+    P_r, P_s = frame.plants(P)
+    proj_r, proj_s = _projections(P_r, sparse)[0], _projections(P_s, sparse)[1]
     cons = [p.lmi(V, g, opts.margin) for p, V in ((proj_r, Rt), (proj_s, St)) if p is not None]
-    # [[R, I], [I, S]] >= 0 with R = T_R R̃ T_Rᵀ, S = T_S S̃ T_Sᵀ, by the orthogonal
-    # congruence diag(T_R, T_S): same eigenvalues, coupling block T_Rᵀ T_S
-    T_r, T_s = (np.eye(n) if p is None else p.T for p in (proj_r, proj_s))
-    M = T_r.T @ T_s
+    # [[R, I], [I, S]] >= 0 becomes [[R̂, Σ⁻¹], [Σ⁻¹, Ŝ]] >= 0 in the frame, and with
+    # R̂ = U_R R̃ U_Rᵀ, Ŝ = U_S S̃ U_Sᵀ (orthogonal) the coupling block is U_Rᵀ Σ⁻¹ U_S
+    U_r, U_s = (np.eye(n) if p is None else p.T for p in (proj_r, proj_s))
+    M = (U_r.T / frame.sigma[None, :]) @ U_s
     cons += [_sym(cp.bmat([[Rt, M], [M.T, St]])) >> 0,
              cp.trace(Rt) + cp.trace(St) <= opts.xy_bound * n]  # rotations keep traces
     prob = cp.Problem(cp.Minimize(g) if gamma is None else cp.Minimize(0), cons)
@@ -257,10 +316,11 @@ def _gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None,
         raise InfeasibleError(f"no controller achieves gamma = {gamma:.6g} "
                               "(the H∞ LMIs are infeasible)")
     gval = float(g.value) if gamma is None else float(gamma)
-    Rv, Sv = _sym(T_r @ Rt.value @ T_r.T), _sym(T_s @ St.value @ T_s.T)
-    if np.trace(Rv) + np.trace(Sv) > 0.99 * opts.xy_bound * n:
+    Rh, Sh = U_r @ Rt.value @ U_r.T, U_s @ St.value @ U_s.T
+    if np.trace(Rh) + np.trace(Sh) > 0.99 * opts.xy_bound * n:
         warnings.append(f"{TRACE_BOUND_ACTIVE} <= {opts.xy_bound:g} n is active; "
                         "the LMI optimum may be above the true infimum")
+    Rv, Sv = frame.lyapunov(_sym(Rh), _sym(Sh))
     return LmiSolution(gval, Rv, Sv, str(status), tuple(warnings))
 
 
@@ -367,26 +427,34 @@ class ControllerLmi:
     free off-diagonal block) and recovered in closed form, which leaves two inequalities
     of size ``n + nw + nz`` instead of one of size ``2n + nw + nz``: on the 22-state
     benchmark plant the solve took 5.2 s instead of 7.7 s (loaded machine), same
-    certified γ.  Near the optimal γ the solution degenerates (``X -> Y⁻¹``, so ``I - XY`` is singular and the controller gets absurdly
-    fast poles).  At a given (relaxed) γ we therefore take the point of largest common
-    slack ``t`` of the bounded-real inequality (``<= -0.1 t I``) and of
-    ``[[Y, I], [I, X]] >= t I`` inside ``trace(X) + trace(Y) <= trace_bound``.
+    certified γ.  Near the optimal γ the solution degenerates (``X -> Y⁻¹``, so
+    ``I - XY`` is singular and the controller gets absurdly fast poles).  At a given
+    (relaxed) γ we therefore take the point of largest common slack ``t`` of the
+    bounded-real inequalities (``<= -0.1 t I``) and of the coupling ``>= t I``, inside
+    ``trace(X̂) + trace(Ŷ) <= trace_bound``.
 
-    γ and the trace bound are CVXPY Parameters, so recoveries re-solve the compiled
-    problem instead of rebuilding it.  ``P`` must have ``D22 = 0`` and should be scaled
-    and balanced (:func:`balancing_transform`); ``P.nstates`` must be positive.
+    The variables are written relative to a :class:`Frame` taken from the γ-optimal
+    ``(R, S)``: ``Y = D Ŷ D`` and ``X = D X̂ D`` in the frame's balanced coordinates,
+    so that the slack ``t`` is a relative margin and ``X̂ ≈ Ŷ ≈ I`` near the optimum.
+
+    γ and the trace bound are CVXPY Parameters, so a re-solve at another level reuses
+    the compiled problem.  ``P`` must have ``D22 = 0`` and should be scaled;
+    ``P.nstates`` must be positive.
     """
 
-    def __init__(self, P: GeneralizedPlant):
-        b = P.blocks()
-        A, B1, B2, C1, C2 = b["A"], b["B1"], b["B2"], b["C1"], b["C2"]
-        D11, D12, D21 = b["D11"], b["D12"], b["D21"]
+    def __init__(self, P: GeneralizedPlant, frame: Frame | None = None):
+        from ..lti.scaling import transform_states
+
         n, nw, nu, nz, ny = P.nstates, P.nw, P.nu, P.nz, P.ny
-        self.P = P
-        self.X = cp.Variable((n, n), symmetric=True)
-        self.Y = cp.Variable((n, n), symmetric=True)
-        self.Bh = cp.Variable((n, ny))
-        self.Ch = cp.Variable((nu, n))
+        self.frame = Frame.identity(n) if frame is None else frame
+        self.Pb = transform_states(P, self.frame.T)  # the controller is built here
+        # the Y inequality in the coordinates of Ŷ, the X inequality in those of X̂
+        br, bs = (Q.blocks() for Q in self.frame.plants(P))
+        D11, D12, D21 = br["D11"], br["D12"], br["D21"]
+        self.X = cp.Variable((n, n), symmetric=True)  # X̂
+        self.Y = cp.Variable((n, n), symmetric=True)  # Ŷ
+        self.Bh = cp.Variable((n, ny))  # B̂ in the X̂ coordinates
+        self.Ch = cp.Variable((nu, n))  # Ĉ in the Ŷ coordinates
         self.Dh = cp.Variable((nu, ny))
         self.gamma = cp.Parameter(nonneg=True)
         self.trace_bound = cp.Parameter(nonneg=True)
@@ -397,19 +465,19 @@ class ControllerLmi:
         # principal parts without that block hold (Scherer et al. 1997, Sec. IV), and
         # Â is then recovered in closed form (:meth:`controller`).  Two LMIs of size
         # n + nw + nz replace one of size 2n + nw + nz.
-        AY = A @ Y + B2 @ Ch
-        XA = X @ A + Bh @ C2
+        AY = br["A"] @ Y + br["B2"] @ Ch
+        XA = X @ bs["A"] + Bh @ bs["C2"]
         E = cp.bmat([[-g * np.eye(nw), (D11 + D12 @ Dh @ D21).T],
                      [D11 + D12 @ Dh @ D21, -g * np.eye(nz)]])
-        self._c = cp.vstack([(B1 + B2 @ Dh @ D21).T, C1 @ Y + D12 @ Ch])
-        self._d = cp.vstack([(X @ B1 + Bh @ D21).T, C1 + D12 @ Dh @ C2])
+        self._c = cp.vstack([(br["B1"] + br["B2"] @ Dh @ D21).T, br["C1"] @ Y + D12 @ Ch])
+        self._d = cp.vstack([(X @ bs["B1"] + Bh @ D21).T, bs["C1"] + D12 @ Dh @ bs["C2"]])
         self._e = E
-        m = 2 * n + nw + nz
-        I = np.eye(n)
+        m = n + nw + nz
         slack = _BRL_SLACK_WEIGHT * t
-        cons = [_sym(cp.bmat([[AY + AY.T, self._c.T], [self._c, E]])) << -slack * np.eye(m - n),
-                _sym(cp.bmat([[XA + XA.T, self._d.T], [self._d, E]])) << -slack * np.eye(m - n),
-                _sym(cp.bmat([[Y, I], [I, X]])) >> t * np.eye(2 * n),
+        Sinv = np.diag(1.0 / self.frame.sigma)
+        cons = [_sym(cp.bmat([[AY + AY.T, self._c.T], [self._c, E]])) << -slack * np.eye(m),
+                _sym(cp.bmat([[XA + XA.T, self._d.T], [self._d, E]])) << -slack * np.eye(m),
+                _sym(cp.bmat([[Y, Sinv], [Sinv, X]])) >> t * np.eye(2 * n),
                 cp.trace(X) + cp.trace(Y) <= self.trace_bound,
                 t <= 1.0]
         self.problem = cp.Problem(cp.Maximize(self.t), cons)
@@ -432,29 +500,40 @@ class ControllerLmi:
         SolverError
             If Clarabel fails after ``opts.max_recoveries`` recoveries.
         """
-        b = self.P.blocks()
+        b = self.Pb.blocks()
         A, B2, C2 = b["A"], b["B2"], b["C2"]
-        n = self.P.nstates
+        n = self.Pb.nstates
         self.gamma.value = float(gamma)
         self.trace_bound.value = float(trace_bound)
         warnings: list[str] = []
         # refined KKT solves: the controller is built from this point, so it must be
-        # accurate (see HinfsynOptions.refine_gamma_minimisation)
-        status = _solve(self.problem, replace(opts, refine_gamma_minimisation=True),
+        # accurate (see HinfsynOptions.refine_gamma_minimisation); Clarabel's default
+        # static regularisation: with 1e-10 its first KKT factorisation failed on the
+        # relative form of COMPleib HE1, while 1e-8 and 1e-7 gave the same controller
+        # (measured 2026-11-25)
+        status = _solve(self.problem, replace(opts, refine_gamma_minimisation=True,
+                                              static_regularization=max(
+                                                  opts.static_regularization,
+                                                  _CONTROLLER_STATIC_REG)),
                         f"controller LMI at gamma={gamma:.6g}", warnings)
         t = self.t.value
         if status in _INFEASIBLE or t is None or t <= 0.0:
             raise InfeasibleError(
-                f"no controller achieves gamma = {gamma:.6g} with trace(X) + trace(Y) <= "
+                f"no controller achieves gamma = {gamma:.6g} with trace(X̂) + trace(Ŷ) <= "
                 f"{trace_bound:.3g}")
-        Xv, Yv = _sym(self.X.value), _sym(self.Y.value)
-        Bhv, Chv, Dk = self.Bh.value, self.Ch.value, self.Dh.value
+        # back to the balanced coordinates: Y = D Ŷ D, X = D X̂ D, Ĉ_b = Ĉ D, B̂_b = D B̂,
+        # and the state columns of c and d scale by D
+        d = np.sqrt(self.frame.sigma)
+        Xv, Yv = _sym(d[:, None] * self.X.value * d[None, :]), \
+            _sym(d[:, None] * self.Y.value * d[None, :])
+        Bhv, Chv, Dk = d[:, None] * self.Bh.value, self.Ch.value * d[None, :], self.Dh.value
         # the eliminated block: with the slack shifted into the diagonal blocks, choosing
         # the (X, Y) block as d^T e^-1 c makes the Schur complement on [w; z]
         # block-diagonal, and each diagonal block is one of the two solved inequalities
         shift = _BRL_SLACK_WEIGHT * float(t) * np.eye(self._e.shape[0])
-        c, d, e = self._c.value, self._d.value, _sym(self._e.value) + shift
-        Ahv = d.T @ np.linalg.solve(e, c) - (A + B2 @ Dk @ C2).T
+        c, dd = self._c.value * d[None, :], self._d.value * d[None, :]
+        e = _sym(self._e.value) + shift
+        Ahv = dd.T @ np.linalg.solve(e, c) - (A + B2 @ Dk @ C2).T
         # N M^T = I - X Y with N = I; M^{-T} applied by solves, never by explicit inverses.
         MT = np.eye(n) - Xv @ Yv
         sv = np.linalg.svd(MT, compute_uv=False)

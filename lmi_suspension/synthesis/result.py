@@ -127,7 +127,7 @@ class HinfsynOptions:
     """
 
     gamma: float | None = None
-    gamma_relax: float = 3e-3
+    gamma_relax: float = 5e-4
     gamma_atol: float = 1e-6
     tol_gap_abs: float = 1e-7
     tol_gap_rel: float = 1e-6
