@@ -58,6 +58,11 @@ _BRL_SLACK_WEIGHT = 0.1
 #: Clarabel's static regularisation in the controller LMI at least (see
 #: :meth:`ControllerLmi.controller`)
 _CONTROLLER_STATIC_REG = 1e-8
+#: static regularisation of the first recovery of a failed solve, tenfold on each next
+#: one: the controller LMI of a D-scaled distillation plant (relative variables with
+#: sigma up to 1.3e7, data from 1e-12 to 4e4) failed at 1e-8 and 1e-7 and was solved at
+#: 1e-6 (measured 2026-11-25)
+_RECOVERY_STATIC_REG = 1e-7
 #: how the warning of an active trace bound in the γ minimisation begins
 TRACE_BOUND_ACTIVE = "the bound trace(X) + trace(Y)"
 
@@ -71,6 +76,12 @@ class LmiSolution:
     S: np.ndarray
     status: str
     warnings: tuple = ()
+
+    @property
+    def clean(self) -> bool:
+        """Solved at the requested tolerances, in the sparse form, away from the trace
+        bound: nothing suggests that a better-conditioned frame would move it."""
+        return self.status == cp.OPTIMAL and not self.warnings
 
 
 def _null(M: np.ndarray) -> np.ndarray:
@@ -108,6 +119,18 @@ class Frame:
     T: np.ndarray
     sigma: np.ndarray
 
+    @property
+    def scale(self) -> np.ndarray:
+        """``D``'s diagonal: ``sqrt(sigma)``, capped at ``sqrt(_SIGMA_CAP)``."""
+        import os
+        cap = float(os.environ.get("SIGMA_CAP", "inf"))
+        return np.sqrt(np.minimum(self.sigma, cap))
+
+    @property
+    def trace(self) -> float:
+        """``trace(R̂) + trace(Ŝ)`` of the solution the frame was built from."""
+        return float(2.0 * np.sum(self.sigma / self.scale**2))
+
     @classmethod
     def identity(cls, n: int) -> "Frame":
         return cls(np.eye(n), np.ones(n))
@@ -122,13 +145,13 @@ class Frame:
         """``P`` in the coordinates of the ``R`` and of the ``S`` inequality."""
         from ..lti.scaling import transform_states
 
-        d = np.sqrt(self.sigma)
+        d = self.scale
         return (transform_states(P, self.T * d[None, :]),
                 transform_states(P, self.T / d[None, :]))
 
     def lyapunov(self, Rh: np.ndarray, Sh: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``(R, S)`` of the plant's own coordinates from the relative ``(R̂, Ŝ)``."""
-        d = np.sqrt(self.sigma)
+        d = self.scale
         Rb, Sb = d[:, None] * Rh * d[None, :], d[:, None] * Sh * d[None, :]
         Ti = np.linalg.inv(self.T)
         return _sym(self.T @ Rb @ self.T.T), _sym(Ti.T @ Sb @ Ti)
@@ -218,8 +241,8 @@ def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
     """Solve with explicit Clarabel settings; recover from inaccurate/failed solves.
 
     Each recovery loosens the tolerances tenfold, doubles the iteration bound, raises
-    the static regularisation and refines every KKT solve iteratively; every recovery
-    is recorded in ``warnings``.
+    the static regularisation (1e-7, 1e-6, ...) and refines every KKT solve
+    iteratively; every recovery is recorded in ``warnings``.
     """
     settings = opts.clarabel_settings()
     attempts = [settings]
@@ -230,7 +253,9 @@ def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
                   reduced_tol_gap_rel=min(1e-2, settings["reduced_tol_gap_rel"] * f),
                   reduced_tol_gap_abs=min(1e-2, settings["reduced_tol_gap_abs"] * f),
                   reduced_tol_feas=min(1e-4, settings["reduced_tol_feas"] * f),
-                  max_iter=int(settings["max_iter"]) * 2, static_regularization_constant=1e-7,
+                  max_iter=int(settings["max_iter"]) * 2,
+                  static_regularization_constant=max(settings["static_regularization_constant"],
+                                                     _RECOVERY_STATIC_REG * 10.0 ** i),
                   iterative_refinement_enable=True)
         attempts.append(kw)
     status = None
@@ -302,7 +327,7 @@ def _gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None,
     # [[R, I], [I, S]] >= 0 becomes [[R̂, Σ⁻¹], [Σ⁻¹, Ŝ]] >= 0 in the frame, and with
     # R̂ = U_R R̃ U_Rᵀ, Ŝ = U_S S̃ U_Sᵀ (orthogonal) the coupling block is U_Rᵀ Σ⁻¹ U_S
     U_r, U_s = (np.eye(n) if p is None else p.T for p in (proj_r, proj_s))
-    M = (U_r.T / frame.sigma[None, :]) @ U_s
+    M = (U_r.T / frame.scale[None, :] ** 2) @ U_s
     cons += [_sym(cp.bmat([[Rt, M], [M.T, St]])) >> 0,
              cp.trace(Rt) + cp.trace(St) <= opts.xy_bound * n]  # rotations keep traces
     prob = cp.Problem(cp.Minimize(g) if gamma is None else cp.Minimize(0), cons)
@@ -474,7 +499,7 @@ class ControllerLmi:
         self._e = E
         m = n + nw + nz
         slack = _BRL_SLACK_WEIGHT * t
-        Sinv = np.diag(1.0 / self.frame.sigma)
+        Sinv = np.diag(1.0 / self.frame.scale**2)
         cons = [_sym(cp.bmat([[AY + AY.T, self._c.T], [self._c, E]])) << -slack * np.eye(m),
                 _sym(cp.bmat([[XA + XA.T, self._d.T], [self._d, E]])) << -slack * np.eye(m),
                 _sym(cp.bmat([[Y, Sinv], [Sinv, X]])) >> t * np.eye(2 * n),
@@ -523,7 +548,7 @@ class ControllerLmi:
                 f"{trace_bound:.3g}")
         # back to the balanced coordinates: Y = D Ŷ D, X = D X̂ D, Ĉ_b = Ĉ D, B̂_b = D B̂,
         # and the state columns of c and d scale by D
-        d = np.sqrt(self.frame.sigma)
+        d = self.frame.scale
         Xv, Yv = _sym(d[:, None] * self.X.value * d[None, :]), \
             _sym(d[:, None] * self.Y.value * d[None, :])
         Bhv, Chv, Dk = d[:, None] * self.Bh.value, self.Ch.value * d[None, :], self.Dh.value
