@@ -76,12 +76,15 @@ class LmiSolution:
     S: np.ndarray
     status: str
     warnings: tuple = ()
+    #: why a better-conditioned frame may move the optimum: a recovery, the plain form
+    #: or an active trace bound (an "almost solved" first attempt is not a reason: its
+    #: γ is within the reduced tolerances)
+    suspect: tuple = ()
 
     @property
     def clean(self) -> bool:
-        """Solved at the requested tolerances, in the sparse form, away from the trace
-        bound: nothing suggests that a better-conditioned frame would move it."""
-        return self.status == cp.OPTIMAL and not self.warnings
+        """Nothing suggests that a better-conditioned frame would move the optimum."""
+        return not self.suspect
 
 
 def _null(M: np.ndarray) -> np.ndarray:
@@ -118,13 +121,14 @@ class Frame:
 
     T: np.ndarray
     sigma: np.ndarray
+    #: ``D = diag(sqrt(min(sigma, cap)))``: directions with larger ``sigma`` keep
+    #: relative variables of order ``sigma / cap``
+    cap: float = float("inf")
 
     @property
     def scale(self) -> np.ndarray:
-        """``D``'s diagonal: ``sqrt(sigma)``, capped at ``sqrt(_SIGMA_CAP)``."""
-        import os
-        cap = float(os.environ.get("SIGMA_CAP", "inf"))
-        return np.sqrt(np.minimum(self.sigma, cap))
+        """``D``'s diagonal."""
+        return np.sqrt(np.minimum(self.sigma, self.cap))
 
     @property
     def trace(self) -> float:
@@ -240,6 +244,8 @@ def _projections(P: GeneralizedPlant, sparse: bool = True):
 def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
     """Solve with explicit Clarabel settings; recover from inaccurate/failed solves.
 
+    Returns the status and the number of recoveries it took (0: the first attempt).
+
     Each recovery loosens the tolerances tenfold, doubles the iteration bound, raises
     the static regularisation (1e-7, 1e-6, ...) and refines every KKT solve
     iteratively; every recovery is recorded in ``warnings``.
@@ -270,7 +276,7 @@ def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
         except cp.error.SolverError as exc:
             status = f"solver_error: {exc}"
         if status in _INFEASIBLE:
-            return status
+            return status, k
         if status in _OK or status in _INACCURATE:
             if k:
                 warnings.append(f"{what}: recovered (attempt {k + 1}) with looser Clarabel "
@@ -278,7 +284,7 @@ def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
             elif status in _INACCURATE:
                 warnings.append(f"{what}: Clarabel status {status!r} (almost solved); "
                                 "the result is certified independently")
-            return status
+            return status, k
         logger.info("%s: Clarabel status %r, trying recovery %d", what, status, k + 1)
     raise SolverError(f"{what}: Clarabel failed after {opts.max_recoveries} recoveries "
                       f"(last status {status!r})", status=str(status))
@@ -310,8 +316,8 @@ def gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None = N
         # failed on the sparse form and not on the plain one (measured 2026-11-24)
         logger.info("gamma_lmi: sparse form failed (%s); plain form", exc)
         sol = _gamma_lmi(P, opts, gamma, frame, sparse=False)
-        return replace(sol, warnings=(f"sparse form failed ({exc}); solved in the plain "
-                                      "form",) + sol.warnings)
+        note = f"sparse form failed ({exc}); solved in the plain form"
+        return replace(sol, warnings=(note,) + sol.warnings, suspect=(note,) + sol.suspect)
 
 
 def _gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None,
@@ -332,8 +338,8 @@ def _gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None,
              cp.trace(Rt) + cp.trace(St) <= opts.xy_bound * n]  # rotations keep traces
     prob = cp.Problem(cp.Minimize(g) if gamma is None else cp.Minimize(0), cons)
     warnings: list[str] = []
-    status = _solve(prob, opts, "gamma minimisation" if gamma is None else
-                    f"feasibility at gamma={gamma:.6g}", warnings)
+    status, recoveries = _solve(prob, opts, "gamma minimisation" if gamma is None else
+                                f"feasibility at gamma={gamma:.6g}", warnings)
     if status in _INFEASIBLE:
         if gamma is None:
             raise InfeasibleError("the H∞ LMIs are infeasible for every γ: no stabilising "
@@ -342,11 +348,13 @@ def _gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None,
                               "(the H∞ LMIs are infeasible)")
     gval = float(g.value) if gamma is None else float(gamma)
     Rh, Sh = U_r @ Rt.value @ U_r.T, U_s @ St.value @ U_s.T
+    suspect = [warnings[-1]] if recoveries else []
     if np.trace(Rh) + np.trace(Sh) > 0.99 * opts.xy_bound * n:
-        warnings.append(f"{TRACE_BOUND_ACTIVE} <= {opts.xy_bound:g} n is active; "
-                        "the LMI optimum may be above the true infimum")
+        suspect.append(f"{TRACE_BOUND_ACTIVE} <= {opts.xy_bound:g} n is active; "
+                       "the LMI optimum may be above the true infimum")
+        warnings.append(suspect[-1])
     Rv, Sv = frame.lyapunov(_sym(Rh), _sym(Sh))
-    return LmiSolution(gval, Rv, Sv, str(status), tuple(warnings))
+    return LmiSolution(gval, Rv, Sv, str(status), tuple(warnings), tuple(suspect))
 
 
 def explicit_controller(P: GeneralizedPlant, sol: LmiSolution, gamma: float):
@@ -536,7 +544,7 @@ class ControllerLmi:
         # static regularisation: with 1e-10 its first KKT factorisation failed on the
         # relative form of COMPleib HE1, while 1e-8 and 1e-7 gave the same controller
         # (measured 2026-11-25)
-        status = _solve(self.problem, replace(opts, refine_gamma_minimisation=True,
+        status, _ = _solve(self.problem, replace(opts, refine_gamma_minimisation=True,
                                               static_regularization=max(
                                                   opts.static_regularization,
                                                   _CONTROLLER_STATIC_REG)),
