@@ -109,26 +109,29 @@ def _nominal_seat_plant():
     return GeneralizedPlant.from_statespace(aug.P, aug.nmeas, aug.ncon)
 
 
-def test_a_failed_reconstruction_relaxes_the_level(monkeypatch):
-    """The first controller LMI solve is made to fail (injected); the next one is at
-    ``4 gamma_relax`` above the LMI optimum, certified there, and the failure is said.
-    Reference: the DGKF closed form of the scalar plant."""
+def test_a_failed_reconstruction_refines_then_relaxes_the_level(monkeypatch):
+    """The first two controller LMI solves are made to fail (injected): the second is
+    at the same level with iterative refinement, the third at ``4 gamma_relax`` above
+    the LMI optimum, certified there; the failures are said.  Reference: the DGKF closed
+    form of the scalar plant."""
     from lmi_suspension.synthesis import lmi
 
     real = lmi.ControllerLmi.controller
     calls = []
 
-    def failing_first(self, gamma, *args, **kwargs):
-        calls.append(gamma)
-        if len(calls) == 1:
+    def failing_twice(self, gamma, trace_bound, opts, refine=True):
+        calls.append((gamma, refine))
+        if len(calls) <= 2:
             raise SolverError("injected failure")
-        return real(self, gamma, *args, **kwargs)
+        return real(self, gamma, trace_bound, opts, refine)
 
-    monkeypatch.setattr(lmi.ControllerLmi, "controller", failing_first)
+    monkeypatch.setattr(lmi.ControllerLmi, "controller", failing_twice)
     res = hinfsyn(scalar_plant(1.0), 1, 1)
     assert_certified(res, scalar_plant(1.0))
-    assert len(calls) == 2 and calls[1] / calls[0] == pytest.approx((1 + 4 * RELAX) / (1 + RELAX))
-    assert any("injected failure" in w for w in res.warnings)
+    (g1, r1), (g2, r2), (g3, r3) = calls
+    assert (r1, r2, r3) == (False, True, True) and g1 == g2
+    assert g3 / g1 == pytest.approx((1 + 4 * RELAX) / (1 + RELAX))
+    assert sum("injected failure" in w for w in res.warnings) == 2
     assert res.gamma_solver == pytest.approx(res.gamma_lower * (1 + 4 * RELAX))
     assert res.gamma <= scalar_gamma_opt(1.0) * (1 + 4 * RELAX) * (1 + 1e-6)
 

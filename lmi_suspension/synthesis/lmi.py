@@ -515,8 +515,11 @@ class ControllerLmi:
                 t <= 1.0]
         self.problem = cp.Problem(cp.Maximize(self.t), cons)
 
-    def controller(self, gamma: float, trace_bound: float, opts: HinfsynOptions):
+    def controller(self, gamma: float, trace_bound: float, opts: HinfsynOptions,
+                   refine: bool = True):
         """The controller at the centre of the feasible set at level ``gamma``.
+
+        ``refine`` turns on Clarabel's iterative refinement of each KKT solve.
 
         Returns
         -------
@@ -539,12 +542,10 @@ class ControllerLmi:
         self.gamma.value = float(gamma)
         self.trace_bound.value = float(trace_bound)
         warnings: list[str] = []
-        # refined KKT solves: the controller is built from this point, so it must be
-        # accurate (see HinfsynOptions.refine_gamma_minimisation); Clarabel's default
-        # static regularisation: with 1e-10 its first KKT factorisation failed on the
-        # relative form of COMPleib HE1, while 1e-8 and 1e-7 gave the same controller
-        # (measured 2026-11-25)
-        status, _ = _solve(self.problem, replace(opts, refine_gamma_minimisation=True,
+        # Clarabel's default static regularisation at least: with 1e-10 its first KKT
+        # factorisation failed on the relative form of COMPleib HE1, while 1e-8 and 1e-7
+        # gave the same controller (measured 2026-11-25)
+        status, _ = _solve(self.problem, replace(opts, refine_gamma_minimisation=refine,
                                               static_regularization=max(
                                                   opts.static_regularization,
                                                   _CONTROLLER_STATIC_REG)),
