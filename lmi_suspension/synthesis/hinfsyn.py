@@ -26,6 +26,21 @@ logger = logging.getLogger(__name__)
 #: each failed reconstruction relaxes the level above the LMI optimum by this factor
 #: more (gamma_relax, 4 gamma_relax, 16 gamma_relax, ...)
 _RELAX_GROWTH = 4.0
+#: the cap of the second frame the controller LMI is tried in.  On a 22-state D-K plant
+#: of the distillation problem (sigma up to 2.5e8) the controller LMI failed in the full
+#: frame (scalings up to 1.6e4 apart) and certified 1.03321 against an LMI optimum of
+#: 1.03277 with the scalings capped at sqrt(100); on COMPleib HE1 (sigma up to 1.8e4)
+#: the full frame gives 0.040 % above the optimum and the capped one 0.16 %
+#: (measured 2026-11-25), hence the order
+_NARROW_SIGMA_CAP = 100.0
+#: a frame whose sigma spans more than this is tried capped first: the same D-K plant
+#: took 13 s in failed full-frame solves before the capped frame certified (measured
+#: 2026-11-25); COMPleib's frames span at most 2e4
+_WIDE_SIGMA = 1e6
+#: recoveries inside one controller LMI solve (the outer ladder handles the rest): the
+#: three-decade D-scaled distillation plant needed two under one OpenBLAS kernel, and
+#: a third and fourth only cost time (measured 2026-11-25)
+_INNER_RECOVERIES = 2
 #: bound on the γ minimisations repeated in the frame of the last one (the three-decade
 #: D-scaled distillation plant needed 4, measured 2026-11-25)
 _FRAME_ROUNDS = 6
@@ -286,11 +301,13 @@ def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warni
 def _reconstruct(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling,
                  sols: list, g_base: float, fixed: bool, opts: HinfsynOptions,
                  warnings: list):
-    """The controller LMI in the frame of each solution of ``sols`` in turn, at
-    ``(1 + r) g_base`` (scaled units), ``r = gamma_relax`` (first without, then with
-    iterative refinement), then ``4 gamma_relax, 16 gamma_relax, ...`` with a trace box
-    ten times wider at each step, until a controller certifies at its level (at a fixed
-    γ, ``r = 0``).
+    """The controller from the controller LMI at ``(1 + r) g_base`` (scaled units), with
+    ``r = gamma_relax, 4 gamma_relax, 16 gamma_relax, ...`` (``r = 0`` at a fixed γ)
+    and a trace box ten times wider at each step; at each level in the frame of the
+    first solution of ``sols``, then in the same frame with its scalings capped
+    (``_NARROW_SIGMA_CAP``), then in the frames of the other solutions, until a
+    controller certifies at its level.  The very first solve runs without iterative
+    refinement and is repeated with it where it fails.
 
     Returns ``(K, CL, gamma, poles, level, status, cond_xy, t_certify)`` with ``level``
     in the plant's units; raises :class:`SolverError` (or, at a fixed γ,
@@ -299,42 +316,51 @@ def _reconstruct(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling,
     n = Ps.nstates
     t_cert = 0.0
     last = None
-    for sol in sols[:1] if n == 0 else sols:
-        lmi_k = _lmi.ControllerLmi(Ps, _lmi.Frame.from_lyapunov(sol.R, sol.S)) if n else None
-        for attempt in range(int(opts.max_recoveries) + 1):
-            # the first attempt without iterative refinement (22-state benchmark plant:
-            # 0.7 s instead of 1.4 s, same controller), the next ones at the same level
-            # with it before any relaxation (COMPleib AC3 needed it under one OpenBLAS
-            # kernel, measured 2026-11-25)
-            refine = attempt > 0
-            step = max(attempt - 1, 0)
-            relax = 0.0 if fixed else opts.gamma_relax * _RELAX_GROWTH ** step
-            g_ctrl = g_base * (1.0 + relax)
-            try:
-                if n == 0:
-                    center = _lmi.LmiSolution(g_ctrl, np.zeros((0, 0)), np.zeros((0, 0)),
-                                              "static")
-                    Ks, cond_xy, _cond_lyap = _lmi.explicit_controller(Ps, center, g_ctrl)
-                    status, cwarn = "static", ()
-                else:
-                    box = opts.center_trace * lmi_k.frame.trace * 10.0 ** step
-                    Ks, cond_xy, status, cwarn = lmi_k.controller(g_ctrl, box, opts, refine)
-                K = _undo_loop_shift(sc.controller_to_original(Ks), G.D22)
-            except (InfeasibleError, SolverError, np.linalg.LinAlgError) as exc:
-                last = exc
-                warnings.append(f"reconstruction at gamma={g_ctrl / sc.gamma_factor:.6g} "
-                                f"failed ({exc})")
-                continue
-            tc = time.perf_counter()
-            cert_warn: list[str] = []
-            level = g_ctrl / sc.gamma_factor
-            CL, gamma, poles = _certify(G, K, level, opts, cert_warn, "lmi")
-            t_cert += time.perf_counter() - tc
-            if np.isfinite(gamma) and not cert_warn:
-                warnings.extend(cwarn)
-                return K, CL, gamma, poles, level, status, cond_xy, t_cert
-            last = "; ".join(cert_warn)
-            warnings.append(f"reconstruction at gamma={level:.6g}: {last}")
+    frames = [(sols[0], np.inf)] if n == 0 else \
+        [(sols[0], np.inf), (sols[0], _NARROW_SIGMA_CAP)] + [(s, np.inf) for s in sols[1:]]
+    if n and np.ptp(np.log10(_lmi.Frame.from_lyapunov(sols[0].R, sols[0].S).sigma)) > \
+            np.log10(_WIDE_SIGMA):
+        frames[:2] = frames[1::-1]
+    lmis: dict = {}
+    # the outer ladder handles a failed solve: one recovery inside it is enough
+    inner = replace(opts, max_recoveries=min(int(opts.max_recoveries), _INNER_RECOVERIES))
+    for step in range(int(opts.max_recoveries) + 1):
+        relax = 0.0 if fixed else opts.gamma_relax * _RELAX_GROWTH ** step
+        g_ctrl = g_base * (1.0 + relax)
+        level = g_ctrl / sc.gamma_factor
+        for j, (sol, cap) in enumerate(frames):
+            # without refinement first (22-state benchmark plant: 0.7 s instead of 1.4 s,
+            # same controller), with it where that fails (COMPleib AC3 under one
+            # OpenBLAS kernel, measured 2026-11-25)
+            for refine in (False, True) if step == 0 and j == 0 else (True,):
+                try:
+                    if n == 0:
+                        center = _lmi.LmiSolution(g_ctrl, np.zeros((0, 0)),
+                                                  np.zeros((0, 0)), "static")
+                        Ks, cond_xy, _c = _lmi.explicit_controller(Ps, center, g_ctrl)
+                        status, cwarn = "static", ()
+                    else:
+                        if j not in lmis:
+                            lmis[j] = _lmi.ControllerLmi(Ps, replace(
+                                _lmi.Frame.from_lyapunov(sol.R, sol.S), cap=cap))
+                        box = opts.center_trace * lmis[j].frame.trace * 10.0 ** step
+                        Ks, cond_xy, status, cwarn = lmis[j].controller(g_ctrl, box, inner,
+                                                                        refine)
+                    K = _undo_loop_shift(sc.controller_to_original(Ks), G.D22)
+                except (InfeasibleError, SolverError, np.linalg.LinAlgError) as exc:
+                    last = exc
+                    warnings.append(f"reconstruction at gamma={level:.6g} (frame {j + 1}) "
+                                    f"failed ({exc})")
+                    continue
+                tc = time.perf_counter()
+                cert_warn: list[str] = []
+                CL, gamma, poles = _certify(G, K, level, opts, cert_warn, "lmi")
+                t_cert += time.perf_counter() - tc
+                if np.isfinite(gamma) and not cert_warn:
+                    warnings.extend(cwarn)
+                    return K, CL, gamma, poles, level, status, cond_xy, t_cert
+                last = "; ".join(cert_warn)
+                warnings.append(f"reconstruction at gamma={level:.6g} (frame {j + 1}): {last}")
     if fixed and isinstance(last, InfeasibleError):
         raise last
     raise SolverError(f"controller reconstruction failed after {opts.max_recoveries} "
