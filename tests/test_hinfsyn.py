@@ -110,35 +110,38 @@ def _nominal_seat_plant():
 
 
 def test_a_failed_reconstruction_refines_then_relaxes_the_level(monkeypatch):
-    """The first two controller LMI solves are made to fail (injected): the second is
-    at the same level with iterative refinement, the third at ``4 gamma_relax`` above
-    the LMI optimum, certified there; the failures are said.  Reference: the DGKF closed
-    form of the scalar plant."""
+    """The first three controller LMI solves are made to fail (injected): the second is
+    at the same level with iterative refinement, the third there in the capped frame,
+    the fourth at ``4 gamma_relax`` above the LMI optimum, certified there; the failures
+    are said.  Reference: the DGKF closed form of the scalar plant."""
     from lmi_suspension.synthesis import lmi
 
     real = lmi.ControllerLmi.controller
     calls = []
 
-    def failing_twice(self, gamma, trace_bound, opts, refine=True):
-        calls.append((gamma, refine))
-        if len(calls) <= 2:
+    def failing_thrice(self, gamma, trace_bound, opts, refine=True):
+        calls.append((gamma, refine, self.frame.cap))
+        if len(calls) <= 3:
             raise SolverError("injected failure")
         return real(self, gamma, trace_bound, opts, refine)
 
-    monkeypatch.setattr(lmi.ControllerLmi, "controller", failing_twice)
+    monkeypatch.setattr(lmi.ControllerLmi, "controller", failing_thrice)
     res = hinfsyn(scalar_plant(1.0), 1, 1)
     assert_certified(res, scalar_plant(1.0))
-    (g1, r1), (g2, r2), (g3, r3) = calls
-    assert (r1, r2, r3) == (False, True, True) and g1 == g2
-    assert g3 / g1 == pytest.approx((1 + 4 * RELAX) / (1 + RELAX))
-    assert sum("injected failure" in w for w in res.warnings) == 2
+    levels, refined, caps = zip(*calls)
+    assert refined == (False, True, True, True)
+    assert caps[0] == caps[1] == caps[3] == np.inf and np.isfinite(caps[2])
+    assert levels[0] == levels[1] == levels[2]
+    assert levels[3] / levels[0] == pytest.approx((1 + 4 * RELAX) / (1 + RELAX))
+    assert sum("injected failure" in w for w in res.warnings) == 3
     assert res.gamma_solver == pytest.approx(res.gamma_lower * (1 + 4 * RELAX))
     assert res.gamma <= scalar_gamma_opt(1.0) * (1 + 4 * RELAX) * (1 + 1e-6)
 
 
 def test_every_reconstruction_failing_is_a_solver_error(monkeypatch):
     """Injected: every controller LMI solve fails; hinfsyn raises SolverError after
-    ``max_recoveries + 1`` attempts and does not hang."""
+    ``max_recoveries + 1`` levels (three solves at the first: without and with
+    refinement, and in the capped frame; two at each next) and does not hang."""
     from lmi_suspension.synthesis import lmi
 
     calls = []
@@ -150,7 +153,7 @@ def test_every_reconstruction_failing_is_a_solver_error(monkeypatch):
     monkeypatch.setattr(lmi.ControllerLmi, "controller", failing)
     with pytest.raises(SolverError, match="reconstruction failed"):
         hinfsyn(scalar_plant(1.0), 1, 1, options=HinfsynOptions(max_recoveries=2))
-    assert len(calls) == 3
+    assert len(calls) == 3 + 2 * 2
 
 
 def test_frame_is_the_relative_form_of_its_own_solution():
