@@ -22,6 +22,11 @@ __all__ = ["hinfsyn"]
 
 logger = logging.getLogger(__name__)
 
+#: trace box of the controller LMI, as a multiple of trace(X̂) + trace(Ŷ) of the γ-optimal
+#: solution in its frame (2n, or more in a capped frame), tenfold at each relaxation: in
+#: the frame the γ-optimal point has X̂ = Ŷ = I, and COMPleib HE1 gave the same
+#: controller with boxes of 10 and 100 times that (measured 2026-11-25)
+_CENTER_TRACE = 10.0
 #: each failed reconstruction relaxes the level above the LMI optimum by this factor
 #: more (gamma_relax, 4 gamma_relax, 16 gamma_relax, ...)
 _RELAX_GROWTH = 4.0
@@ -342,7 +347,7 @@ def _reconstruct(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling,
                         if j not in lmis:
                             lmis[j] = _lmi.ControllerLmi(Ps, replace(
                                 _lmi.Frame.from_lyapunov(sol.R, sol.S), cap=cap))
-                        box = opts.center_trace * lmis[j].frame.trace * 10.0 ** step
+                        box = _CENTER_TRACE * lmis[j].frame.trace * 10.0 ** step
                         Ks, cond_xy, status, cwarn = lmis[j].controller(g_ctrl, box, inner,
                                                                         refine)
                     K = _undo_loop_shift(sc.controller_to_original(Ks), G.D22)

@@ -45,10 +45,6 @@ class HinfsynOptions:
     xy_bound : float
         Bound ``trace(X) + trace(Y) <= xy_bound * n`` (scaled data) that keeps the γ
         minimisation bounded; a warning says when it is active.
-    center_trace : float
-        Trace box of the controller LMI, as a multiple of ``trace(X̂) + trace(Ŷ)`` of the
-        γ-optimal solution in the relative variables of its frame (see
-        :class:`~lmi_suspension.synthesis.lmi.Frame`); multiplied by 10 on each recovery.
     max_recoveries : int
         Number of recovery attempts (tightened tolerances, relaxed γ) after an
         inaccurate or failed solve.
@@ -123,7 +119,6 @@ class HinfsynOptions:
     max_iter: int = 200
     margin: float = 1e-8
     xy_bound: float = 1e5
-    center_trace: float = 10.0
     max_recoveries: int = 4
     scale: bool = True
     cert_rtol: float = 5e-3
@@ -143,7 +138,7 @@ class HinfsynOptions:
             raise ParameterError(f"gamma must be positive and finite, got {self.gamma!r}")
         for name in ("static_regularization", "gamma_relax", "gamma_atol",
                      "tol_gap_abs", "tol_gap_rel", "tol_feas", "margin", "xy_bound",
-                     "center_trace", "cert_rtol", "reduced_tol_gap_abs", "riccati_rtol",
+                     "cert_rtol", "reduced_tol_gap_abs", "riccati_rtol",
                      "reduced_tol_gap_rel", "reduced_tol_feas"):
             v = getattr(self, name)
             if not (np.isfinite(v) and v > 0):
