@@ -53,7 +53,10 @@ def test_distillation_reaches_below_one(distillation_design):
     assert res.history[0].mu_peak == pytest.approx(PUBLISHED_MU_ITER1, rel=0.005)
     assert res.history[1].mu_peak == pytest.approx(PUBLISHED_MU_ITER2, rel=0.01)
     dk_steps = [h for h in res.history if h.stage == "dk"]
-    assert min(h.mu_peak for h in dk_steps) < 1.015  # 1.0123 measured
+    # 1.0123 measured on 2026-11-24, 1.0157 on 2026-11-25 once the scaled plants were
+    # the exact series connections (minreal's realization had let K-steps certify below
+    # the µ of their own loop)
+    assert min(h.mu_peak for h in dk_steps) < 1.02
     search = res.history[-1]
     assert search.stage == "dscale_search" and res.best_iteration == search.index
     assert search.gamma < search.gamma_prev  # below the γ of its starting scalings
@@ -327,12 +330,13 @@ def test_kstep_with_the_published_optimal_dscales_reaches_the_book_optimum():
     assert np.max(mu.upper) == pytest.approx(LUNDSTROM_MU, rel=1e-3)  # 0.97396 measured
     assert np.max(mu.lower) >= np.max(mu.upper) * (1 - 1e-6)
     # python-control's Riccati (SLICOT sb10ad) on the series realization of this scaled
-    # plant certifies far above the optimum (2.09 measured on 2026-11-23, 1.0958 on
-    # 2026-11-24 with slycot 0.7.1 and the same code: its result on this realization
-    # is at the mercy of rounding); only the Gramian-balanced realization gives the
-    # optimal controller.  If slycot improves, this says so.
+    # plant can certify far above the optimum (2.09 measured on 2026-11-23, 1.0958 on
+    # 2026-11-24 with slycot 0.7.1 and the same code, 1.0029 under another OpenBLAS
+    # kernel): its result on this realization is at the mercy of rounding, which is why
+    # the K-step also runs it on a Gramian-balanced realization.  That defect shows only
+    # on some machines, so it is not asserted; the K-step's result above is.
     plain = [g for method, as_given, g in calls if method == "riccati" and as_given]
-    assert plain and min(plain) > 1.05 * LUNDSTROM_GAMMA
+    assert plain and min(plain) >= syn.gamma * (1 - 1e-9)  # the K-step kept the best
 
 
 def test_blk_must_fit_the_plant():
