@@ -371,6 +371,17 @@ def _reconstruct(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling,
                       f"recoveries: {last}")
 
 
+def _unit_gamma(Ps: GeneralizedPlant, sc: PlantScaling, g: float, sols: list):
+    """The errors scaled by ``1/f`` (``f``: ``g`` rounded to a power of two) so that the
+    controller LMI sees γ near 1; in the bounded-real inequality this maps ``γ -> γ/f``,
+    ``S -> S / f`` and ``R -> f R``.  Returns ``(plant, scaling, g / f, solutions)``."""
+    if g == 1.0:
+        return Ps, sc, g, sols
+    f = float(np.exp2(np.round(np.log2(g))))
+    Ps, sc = sc.with_error_scale(Ps, g)
+    return Ps, sc, g / f, [replace(s, gamma=s.gamma / f, R=s.R * f, S=s.S / f) for s in sols]
+
+
 def _refined_gamma_lmi(Ps: GeneralizedPlant, opts: HinfsynOptions,
                        sol: "_lmi.LmiSolution | None" = None
                        ) -> tuple["_lmi.LmiSolution", list]:
@@ -439,14 +450,7 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
         g_base = float(opts.gamma) * sc.gamma_factor
         sol = _lmi.gamma_lmi(Ps, opts, gamma=g_base)
     warnings += list(sol.warnings)
-    if g_base != 1.0:
-        # errors scaled by 1/f (a power of two) so that the controller LMI sees γ near 1;
-        # in the bounded-real inequality this maps S -> S / f and R -> f R
-        f = float(np.exp2(np.round(np.log2(g_base))))
-        Ps, sc = sc.with_error_scale(Ps, g_base)
-        g_base = g_base / f
-        sol, *earlier = (replace(s, gamma=s.gamma / f, R=s.R * f, S=s.S / f)
-                         for s in [sol] + earlier)
+    Ps, sc, g_base, (sol, *earlier) = _unit_gamma(Ps, sc, g_base, [sol] + earlier)
     t_solve = time.perf_counter() - t1
 
     t2 = time.perf_counter()
@@ -455,28 +459,31 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
     result = _reconstruct(G, Ps, sc, [sol] + earlier[-1:], g_base, fixed, opts, warnings)
     gamma, t_cert = result[2], result[-1]
     t_refine = 0.0
-    if not fixed and Ps.nstates and not earlier and \
-            gamma < gamma_lower * (1.0 - opts.gamma_relax):
+    if not fixed and Ps.nstates and gamma < gamma_lower * (1.0 - opts.gamma_relax):
         # a controller beats the optimum of a minimisation that looked clean (nominal seat
-        # plant: 0.8487 certified below 0.8514, measured 2026-11-25): refine it in its
-        # frame and reconstruct again; the better certified controller is kept
+        # plant: 0.8487 certified below 0.8514; the three-decade D-scaled distillation
+        # plant under one OpenBLAS kernel: 1.356 below 4.59 after two frame rounds,
+        # measured 2026-11-25): refine it further in its frame and reconstruct again;
+        # the better certified controller is kept
         t3 = time.perf_counter()
         ref, earlier = _refined_gamma_lmi(Ps, opts, replace(sol, warnings=()))
         t_refine = time.perf_counter() - t3
         t_solve += t_refine
         if earlier:
             warnings += list(ref.warnings)
+            # the refined optimum is the better estimate, whatever the reconstruction gives
+            gamma_lower = ref.gamma / sc.gamma_factor
+            P2, sc2, g2, sols2 = _unit_gamma(Ps, sc, max(ref.gamma, opts.gamma_atol),
+                                             [ref] + earlier[-1:])
             again: list[str] = []
             try:
-                alt = _reconstruct(G, Ps, sc, [ref] + earlier[-1:],
-                                   max(ref.gamma, opts.gamma_atol), fixed, opts, again)
+                alt = _reconstruct(G, P2, sc2, sols2, g2, fixed, opts, again)
             except SolverError as exc:
                 warnings.append(f"reconstruction after the refinement failed ({exc})")
             else:
                 t_cert += alt[-1]
                 if alt[2] < gamma:
                     warnings += again
-                    gamma_lower = ref.gamma / sc.gamma_factor
                     result = alt[:-1] + (t_cert,)
     K, CL, gamma, poles, level, status, cond_xy, _ = result
     if gamma_lower is not None and gamma < gamma_lower * (1.0 - opts.gamma_relax):
