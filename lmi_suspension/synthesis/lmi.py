@@ -283,6 +283,14 @@ def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
             status = prob.status
         except cp.error.SolverError as exc:
             status = f"solver_error: {exc}"
+        except BaseException as exc:  # noqa: B036 - see below
+            # Clarabel's Rust core can panic (an index out of bounds in its KKT assembly
+            # on a D-scaled distillation plant under OpenBLAS's Nehalem kernel, measured
+            # 2026-11-25); pyo3 raises that as PanicException, a BaseException: a failed
+            # attempt like any other, never a crash of the caller
+            if type(exc).__name__ != "PanicException":
+                raise
+            status = f"solver_panic: {exc}"
         if status in _INFEASIBLE:
             return status, k
         if status in _OK or status in _INACCURATE:
