@@ -84,9 +84,9 @@ class LmiSolution:
     S: np.ndarray
     status: str
     warnings: tuple = ()
-    #: why a better-conditioned frame may move the optimum: a recovery, the plain form
-    #: or an active trace bound (an "almost solved" first attempt is not a reason: its
-    #: γ is within the reduced tolerances)
+    #: why a better-conditioned frame may move the optimum: a recovery or the plain form
+    #: (an "almost solved" first attempt is not a reason: its γ is within the reduced
+    #: tolerances)
     suspect: tuple = ()
 
     @property
@@ -366,9 +366,12 @@ def _gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None,
     Rh, Sh = U_r @ Rt.value @ U_r.T, U_s @ St.value @ U_s.T
     suspect = [warnings[-1]] if recoveries else []
     if np.trace(Rh) + np.trace(Sh) > 0.99 * opts.xy_bound * n:
-        suspect.append(f"{TRACE_BOUND_ACTIVE} <= {opts.xy_bound:g} n is active; "
-                       "the LMI optimum may be above the true infimum")
-        warnings.append(suspect[-1])
+        # said, but not a reason for a frame round by itself: where the bound held the
+        # optimum up, the controller certifies below it and hinfsyn refines then (a
+        # round on the 30-state benchmark plant gained 2e-4 for 2.5 s, measured
+        # 2026-11-25)
+        warnings.append(f"{TRACE_BOUND_ACTIVE} <= {opts.xy_bound:g} n is active; "
+                        "the LMI optimum may be above the true infimum")
     Rv, Sv = frame.lyapunov(_sym(Rh), _sym(Sh))
     return LmiSolution(gval, Rv, Sv, str(status), tuple(warnings), tuple(suspect))
 
