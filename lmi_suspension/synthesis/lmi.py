@@ -240,13 +240,13 @@ class _Projection:
                              [self.H.T, -gamma * np.eye(nw)]]))
 
 
-def _projections(P: GeneralizedPlant, sparse: bool = True):
-    """The ``R`` and ``S`` inequalities' projections (``D22 = 0``)."""
-    b = P.blocks()
-    A, B1, B2, C1, C2 = b["A"], b["B1"], b["B2"], b["C1"], b["C2"]
-    D11, D12, D21 = b["D11"], b["D12"], b["D21"]
-    return (_Projection.build(A, B2, C1, D12, B1, D11, sparse),
-            _Projection.build(A.T, C2.T, B1.T, D21.T, C1.T, D11.T, sparse))
+def _projections(P_r: GeneralizedPlant, P_s: GeneralizedPlant, sparse: bool = True):
+    """The ``R`` inequality's projection for ``P_r`` and the ``S`` inequality's for
+    ``P_s`` (the same plant in the coordinates of each, ``D22 = 0``)."""
+    r, s = P_r.blocks(), P_s.blocks()
+    return (_Projection.build(r["A"], r["B2"], r["C1"], r["D12"], r["B1"], r["D11"], sparse),
+            _Projection.build(s["A"].T, s["C2"].T, s["B1"].T, s["D21"].T, s["C1"].T,
+                              s["D11"].T, sparse))
 
 
 def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
@@ -284,7 +284,7 @@ def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
         except cp.error.SolverError as exc:
             status = f"solver_error: {exc}"
         except BaseException as exc:  # noqa: B036 - see below
-            # Clarabel's Rust core can panic (an index out of bounds in its KKT assembly
+            # Clarabel's Rust core can panic (an index out of bounds in its chordal decomposition
             # on a D-scaled distillation plant under OpenBLAS's Nehalem kernel, measured
             # 2026-11-25); pyo3 raises that as PanicException, a BaseException: a failed
             # attempt like any other, never a crash of the caller
@@ -344,7 +344,7 @@ def _gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None,
     St = cp.Variable((n, n), symmetric=True)
     g = cp.Variable(nonneg=True) if gamma is None else float(gamma)
     P_r, P_s = frame.plants(P)
-    proj_r, proj_s = _projections(P_r, sparse)[0], _projections(P_s, sparse)[1]
+    proj_r, proj_s = _projections(P_r, P_s, sparse)
     cons = [p.lmi(V, g, opts.margin) for p, V in ((proj_r, Rt), (proj_s, St)) if p is not None]
     # [[R, I], [I, S]] >= 0 becomes [[R̂, Σ⁻¹], [Σ⁻¹, Ŝ]] >= 0 in the frame, and with
     # R̂ = U_R R̃ U_Rᵀ, Ŝ = U_S S̃ U_Sᵀ (orthogonal) the coupling block is U_Rᵀ Σ⁻¹ U_S
