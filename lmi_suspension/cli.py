@@ -1,4 +1,4 @@
-"""Command line: ``lmi-suspension model | reproduce | simulate``."""
+"""Command line: ``lmi-suspension model | reproduce | simulate | sweep``."""
 
 from __future__ import annotations
 
@@ -117,6 +117,84 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    from .errors import ParameterError
+    from .sweep import SweepSpec, run_sweep
+    from .sweep.spec import parse_range
+
+    axes = [("m3", args.m3), ("delay", args.delay)]
+    for item in args.param or ():
+        name, sep, value = item.partition("=")
+        if not sep or not name:
+            raise ParameterError(f"--param: expected NAME=RANGE, got {item!r}")
+        axes.append((name.strip(), value.strip()))
+    axes = [(n, v) for n, v in axes if v is not None]
+    if args.spec is not None:
+        if axes or args.controller or args.samples:
+            raise ParameterError("--spec: give the axes and controllers in the spec file, "
+                                 "not also as flags")
+        spec = SweepSpec.from_toml(args.spec)
+    else:
+        controllers = tuple(args.controller or ("passive",))
+        if args.samples:
+            ranges = []
+            for name, value in axes:
+                lo, sep, hi = value.partition(":")
+                if not sep or ":" in hi:
+                    raise ParameterError(f"{name}: with --samples give a range lo:hi, "
+                                         f"got {value!r}")
+                ranges.append((name, *parse_range([lo, hi], name)))
+            spec = SweepSpec(controllers=controllers, samples=args.samples,
+                             ranges=tuple(ranges), road=args.road, duration=args.duration,
+                             seed=args.seed, limit=not args.no_limit)
+        else:
+            grid = tuple((n, parse_range(v, n)) for n, v in axes)
+            spec = SweepSpec(controllers=controllers, grid=grid, road=args.road,
+                             duration=args.duration, seed=args.seed, limit=not args.no_limit)
+    bar = _progress_bar(args, spec.n_cases, "cases")
+    try:
+        res = run_sweep(spec, args.out, scheduler=args.scheduler, workers=args.workers,
+                        progress=bar.update if bar is not None else None)
+    finally:
+        if bar is not None:
+            bar.close()
+    out = sys.stdout
+    out.write(f"{res.n_cases} cases ({res.n_run} run now, {res.n_skipped} found finished, "
+              f"{res.n_failed} with an error) in {res.wall_seconds:.1f} s on "
+              f"{res.workers} worker(s): {res.throughput:.2f} cases/s\n")
+    out.write(f"  table   {res.table}\n")
+    for fig in res.figures:
+        out.write(f"  figure  {fig}\n")
+    return 0 if res.n_failed == 0 else 1
+
+
+class _Bar:
+    """A tqdm bar fed with cumulative counts (what the library's callbacks report)."""
+
+    def __init__(self, total: int, unit: str):
+        from tqdm import tqdm
+
+        self._bar = tqdm(total=total, unit=unit, file=sys.stderr, dynamic_ncols=True)
+        self._seen = 0
+
+    def update(self, done: int, total: int | None = None) -> None:
+        if total is not None and total != self._bar.total:
+            self._bar.total = total
+            self._bar.refresh()
+        self._bar.update(done - self._seen)
+        self._seen = done
+
+    def close(self) -> None:
+        self._bar.close()
+
+
+def _progress_bar(args: argparse.Namespace, total: int, unit: str):
+    """A progress bar on a terminal; None under --quiet or when stderr is not one."""
+    if getattr(args, "quiet", False) or not sys.stderr.isatty():
+        return None
+    return _Bar(total, unit)
+
+
 class _Parser(argparse.ArgumentParser):
     """Usage errors as one line (exit code 2), like every other error of the CLI."""
 
@@ -157,6 +235,38 @@ def build_parser() -> argparse.ArgumentParser:
     p_sim.add_argument("--plot", default=None, help="write the z3'' response to this PNG")
     p_sim.add_argument("--json", action="store_true", help="print the metrics as JSON")
     p_sim.set_defaults(func=_cmd_simulate)
+
+    p_sw = sub.add_parser(
+        "sweep", help="robustness maps: many simulations over seat, delay, road and "
+        "controllers on Dask, written to DIR/results.parquet with figures",
+        description="A grid (ranges start:stop:count) or, with --samples, a Monte-Carlo "
+        "(ranges lo:hi) over the seat's parameters, the delay and the road, for each "
+        "controller; run on a local Dask cluster or on --scheduler. Re-running into the "
+        "same --out skips the finished cases.")
+    p_sw.add_argument("--controller", action="append", default=None,
+                      help="controller JSON (repeatable; 'passive' for none)")
+    p_sw.add_argument("--m3", default=None, help="upper-body mass, kg (e.g. 30:70:9)")
+    p_sw.add_argument("--delay", default=None, help="actuator delay, s (e.g. 0:0.05:11)")
+    p_sw.add_argument("--param", action="append", default=None, metavar="NAME=RANGE",
+                      help="another axis: a seat parameter (k1, c2, ...) or the road's "
+                           "(height, length, speed_kmh; psd)")
+    p_sw.add_argument("--road", choices=("bump", "iso8608", "noise"), default="bump",
+                      help="the road (default bump, eq. 32)")
+    p_sw.add_argument("--duration", type=float, default=None,
+                      help="record length, s (bump 3, others 5)")
+    p_sw.add_argument("--samples", type=int, default=0,
+                      help="Monte-Carlo: this many cases per controller, axes as lo:hi")
+    p_sw.add_argument("--seed", type=int, default=0, help="entropy of every case's seed (0)")
+    p_sw.add_argument("--no-limit", action="store_true",
+                      help="skip the physical limit (bump LP) and limit_ratio")
+    p_sw.add_argument("--spec", default=None, help="a TOML spec file instead of the flags")
+    p_sw.add_argument("--out", required=True, help="output directory")
+    p_sw.add_argument("--scheduler", default=None,
+                      help="address of a running Dask scheduler (default: a local cluster)")
+    p_sw.add_argument("--workers", type=int, default=None,
+                      help="worker processes of the local cluster (default 2; 0: no Dask)")
+    p_sw.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
+    p_sw.set_defaults(func=_cmd_sweep)
     return parser
 
 

@@ -1,0 +1,116 @@
+"""One sweep case, evaluated: a pure function of the :class:`~.spec.Case` and the controller,
+run on whichever worker the scheduler picks.
+
+A case that raises records its error in its row (``error``) instead of ending the sweep.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+import traceback
+
+import numpy as np
+
+from ..seat import (
+    SeatParameters,
+    bump,
+    bump_limit,
+    closed_loop_stable,
+    iso8608_road,
+    simulate,
+    white_noise,
+)
+from .spec import PASSIVE, PLANT_AXES, ROADS, SIM_STEP, Case
+
+__all__ = ["evaluate_batch", "evaluate_case", "limit_key", "compute_limit", "METRIC_COLUMNS"]
+
+#: the result columns of every row, after the case's index, controller and axis values
+METRIC_COLUMNS = ("delay_used", "stable", "stable_sim", "peak_z3dd", "rms_z3dd",
+                  "wrms_z3dd", "vdv_z3dd", "peak_x1", "x1_within_limit", "peak_u",
+                  "saturation_time", "limit_peak", "limit_ratio", "seconds", "error")
+#: the LP step of the physical limit, s (bump_limit's default: 1500 steps over 3 s)
+_LIMIT_DT = 2e-3
+
+
+def _params(values: dict) -> SeatParameters:
+    return SeatParameters(**{k: float(v) for k, v in values.items() if k in PLANT_AXES})
+
+
+def _road(road: str, settings: dict, values: dict, rng: np.random.Generator):
+    s = dict(settings)
+    s.update({k: v for k, v in values.items() if k in ROADS[road]})
+    if road == "bump":
+        return bump(s["height"], s["length"], s["speed_kmh"], t_end=s["duration"], dt=1e-3)
+    if road == "iso8608":
+        return iso8608_road(str(s["road_class"]), s["speed_kmh"], s["duration"], 1e-3, rng=rng)
+    return white_noise(s["duration"], 1e-3, psd=s["psd"], bandwidth_hz=s["bandwidth_hz"],
+                       rng=rng)
+
+
+def limit_key(case: Case, road: str, settings: dict) -> tuple | None:
+    """What the physical limit of ``case`` depends on (its seat and its bump), or None where
+    there is no limit to compute (other roads)."""
+    if road != "bump":
+        return None
+    seat = tuple(sorted((k, float(v)) for k, v in case.values.items() if k in PLANT_AXES))
+    bump_values = tuple((k, float(case.values.get(k, settings[k]))) for k in ROADS["bump"])
+    return seat + bump_values + (("duration", float(settings["duration"])),)
+
+
+def compute_limit(key: tuple) -> float:
+    """The clairvoyant LP's certified peak ``|z3''|`` for a key of :func:`limit_key`
+    (nan where the LP fails: the row says so in ``limit_ratio``)."""
+    d = dict(key)
+    p = _params(d)
+    road = bump(d["height"], d["length"], d["speed_kmh"], t_end=d["duration"], dt=1e-3)
+    try:
+        return float(bump_limit(road, p, dt=_LIMIT_DT).certified_peak)
+    except Exception:  # an infeasible or failed LP: no limit for this seat, not no sweep
+        return float("nan")
+
+
+def evaluate_case(case: Case, K, road: str, settings: dict, limit: float | None) -> dict:
+    """The row of one case (``K`` the controller, None for the passive seat)."""
+    t0 = time.perf_counter()
+    row = {"case": case.index, "controller": case.controller, **case.values}
+    row.update({c: None for c in METRIC_COLUMNS})
+    try:
+        p = _params(case.values)
+        delay = float(case.values.get("delay", 0.0))
+        r = _road(road, settings, case.values, case.rng())
+        res = simulate(K, r, delay=delay, params=p, dt=SIM_STEP)
+        m = res.metrics()
+        stable_lin = True if K is None else bool(closed_loop_stable(K, delay, p))
+        peak = float(m.peak_z3dd)
+        row.update(delay_used=res.delay, stable=stable_lin, stable_sim=bool(m.stable),
+                   peak_z3dd=peak, rms_z3dd=float(m.rms_z3dd),
+                   wrms_z3dd=float(m.weighted_rms_z3dd), vdv_z3dd=float(m.vdv_z3dd),
+                   peak_x1=float(m.peak_x1), x1_within_limit=bool(m.x1_within_limit),
+                   peak_u=float(m.peak_u), saturation_time=float(m.saturation_time))
+        if limit is not None:
+            row["limit_peak"] = float(limit)
+            row["limit_ratio"] = peak / limit if limit > 0 else math.nan
+    except Exception as exc:  # recorded in the row; the sweep goes on
+        last = traceback.extract_tb(exc.__traceback__)[-1]
+        row["error"] = f"{type(exc).__name__}: {exc} ({last.filename.split('/')[-1]}:" \
+                       f"{last.lineno})"
+    row["seconds"] = time.perf_counter() - t0
+    return row
+
+
+def evaluate_batch(cases: list, controllers: dict, road: str, settings: dict,
+                   limits: dict) -> list[dict]:
+    """Rows of a batch of cases.  ``controllers`` maps each controller entry to its saved
+    dict (rebuilt exactly here, on the worker); ``limits`` maps limit keys to peaks."""
+    from ..io import controller_from_dict
+
+    built = {name: (None if name == PASSIVE else controller_from_dict(d))
+             for name, d in controllers.items()}
+    rows = []
+    for case in cases:
+        key = limit_key(case, road, settings)
+        rows.append(evaluate_case(case, built[case.controller], road, settings,
+                                  None if key is None else limits.get(key)))
+    return rows
+

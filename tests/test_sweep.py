@@ -1,0 +1,356 @@
+"""Sweeps on Dask: specs, determinism across workers and order, resume, dead workers, errors.
+
+The clusters here are real: a LocalCluster of worker processes, and a ``dask scheduler`` and
+``dask worker`` started as separate processes on localhost.
+"""
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import control
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from lmi_suspension.errors import InputError, ParameterError
+from lmi_suspension.io import save_controller
+from lmi_suspension.seat import SeatParameters, bump, closed_loop_stable, simulate
+from lmi_suspension.sweep import SweepSpec, parse_range, read_results, run_sweep
+from lmi_suspension.sweep.spec import SIM_STEP
+
+#: a simple stabilising controller of the seat (u = -k (x1 velocity-free PD on x1)); the
+#: sweep's numbers are the simulator's, checked against it below, so any controller does
+K_SIMPLE = control.ss([[-200.0]], [[200.0, 0.0]], [[-3000.0]], [[-1500.0, 0.0]])
+
+
+@pytest.fixture(scope="module")
+def controller_file(tmp_path_factory):
+    return save_controller(tmp_path_factory.mktemp("k") / "k.json", K_SIMPLE,
+                           inputs=["x1", "x3"], outputs=["u"])
+
+
+def _spec(controller_file, **kw):
+    base = dict(controllers=(str(controller_file), "passive"),
+                grid=(("m3", (40.0, 60.0)), ("delay", (0.0, 0.01, 0.02))), duration=0.6,
+                limit=False)
+    base.update(kw)
+    return SweepSpec(**base)
+
+
+def _rows(out):
+    """The table's rows without the wall-time column (the only one that may differ)."""
+    table, _ = read_results(out)
+    return [{k: v for k, v in r.items() if k != "seconds"} for r in table.to_pylist()]
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory, controller_file):
+    """The sweep evaluated in this process, one batch after another."""
+    out = tmp_path_factory.mktemp("ref")
+    res = run_sweep(_spec(controller_file), out, workers=0, figures=False)
+    assert res.n_run == res.n_cases == 12 and res.n_failed == 0
+    return _rows(out)
+
+
+# ----------------------------------------------------------------- spec
+
+
+def test_parse_range_forms():
+    assert parse_range("30:70:9", "m3") == tuple(np.linspace(30, 70, 9))
+    assert parse_range("0.01", "delay") == (0.01,)
+    assert parse_range([1, 2.5], "k1") == (1.0, 2.5)
+
+
+@pytest.mark.parametrize("text, match", [
+    ("30:70:0", "m3: empty range"), ("30:70", "m3: expected start:stop:count"),
+    ("30:x:3", "m3: 'x' is not a number"), ("30:70:2.5", "m3: count"),
+    ([], "m3: empty list"), ("nan", "m3: 'nan' is not finite")])
+def test_parse_range_errors_name_the_field(text, match):
+    with pytest.raises(ParameterError, match=match):
+        parse_range(text, "m3")
+
+
+@pytest.mark.parametrize("kw, match", [
+    (dict(grid=(("m4", (1.0,)),)), "m4: unknown parameter"),
+    (dict(grid=(("m3", ()),)), "m3: empty list"),
+    (dict(grid=(("m3", (-1.0,)),)), "m3: -1.0 must be positive"),
+    (dict(grid=(("delay", (-0.01,)),)), "delay: -0.01 s is negative"),
+    (dict(grid=(("m3", (1.0,)), ("m3", (2.0,)))), "m3: given twice"),
+    (dict(road="gravel"), "road: unknown road"),
+    (dict(road="noise", grid=(("height", (0.1,)),)), "height: unknown parameter"),
+    (dict(road_options=(("psd", 1.0),)), "road_options: 'psd'"),
+    (dict(samples=3), "samples: Monte-Carlo needs"),
+    (dict(ranges=(("m3", 30.0, 70.0),)), "ranges: Monte-Carlo ranges given"),
+    (dict(samples=2, ranges=(("m3", 70.0, 30.0),)), "m3: Monte-Carlo range"),
+    (dict(controllers=()), "controllers")])
+def test_bad_specs_are_typed_errors_naming_the_field(kw, match):
+    with pytest.raises(ParameterError, match=match):
+        SweepSpec(**kw)
+
+
+def test_cases_are_numbered_controller_then_grid_outer_axis_first(controller_file):
+    spec = _spec(controller_file)
+    cases = spec.cases()
+    assert spec.n_cases == len(cases) == 12
+    assert [c.index for c in cases] == list(range(12))
+    assert [(c.controller == "passive", c.values["m3"], c.values["delay"]) for c in cases[:4]] \
+        == [(False, 40.0, 0.0), (False, 40.0, 0.01), (False, 40.0, 0.02), (False, 60.0, 0.0)]
+    assert all(c.controller == "passive" for c in cases[6:])
+
+
+def test_delays_are_rounded_to_the_simulation_step():
+    spec = SweepSpec(grid=(("delay", parse_range("0:0.05:4", "delay")),))
+    assert [c.values["delay"] for c in spec.cases()] == [
+        round(d / SIM_STEP) * SIM_STEP for d in np.linspace(0, 0.05, 4)]
+
+
+def test_monte_carlo_draws_come_from_each_cases_spawned_seed():
+    spec = SweepSpec(samples=5, ranges=(("m3", 30.0, 70.0), ("k1", 2e4, 4e4)), seed=7)
+    cases = spec.cases()
+    # independent route: SeedSequence.spawn, as numpy documents it
+    children = np.random.SeedSequence(7).spawn(5)
+    for case, child in zip(cases, children):
+        rng = np.random.default_rng(child)
+        assert case.values == {"m3": rng.uniform(30.0, 70.0), "k1": rng.uniform(2e4, 4e4)}
+    assert len({c.values["m3"] for c in cases}) == 5
+
+
+def test_spec_round_trips_through_json_and_reads_toml(tmp_path, controller_file):
+    spec = _spec(controller_file, road_options=(("height", 0.05),), seed=3)
+    assert SweepSpec.from_json(spec.to_json()) == spec
+    (tmp_path / "k.json").write_text(Path(controller_file).read_text())
+    (tmp_path / "s.toml").write_text(
+        'controllers = ["k.json", "passive"]\nroad = "bump"\nduration = 0.6\nlimit = false\n'
+        "[road_options]\nheight = 0.05\n[grid]\nm3 = [40, 60]\ndelay = \"0:0.02:3\"\n"
+        "[monte_carlo]\nsamples = 2\nk1 = [25000, 37000]\n")
+    read = SweepSpec.from_toml(tmp_path / "s.toml")
+    assert read.controllers == (str(tmp_path / "k.json"), "passive")
+    assert read.grid == (("m3", (40.0, 60.0)), ("delay", (0.0, 0.01, 0.02)))
+    assert read.samples == 2 and read.ranges == (("k1", 25000.0, 37000.0),)
+    assert read.n_cases == 2 * 2 * 3 * 2
+    (tmp_path / "bad.toml").write_text("[grid]\nm9 = [1]\n")
+    with pytest.raises(ParameterError, match="m9: unknown parameter"):
+        SweepSpec.from_toml(tmp_path / "bad.toml")
+    (tmp_path / "bad2.toml").write_text("speed = 3\n")
+    with pytest.raises(ParameterError, match="speed: unknown key"):
+        SweepSpec.from_toml(tmp_path / "bad2.toml")
+    with pytest.raises(InputError, match="spec file"):
+        SweepSpec.from_toml(tmp_path / "missing.toml")
+
+
+@pytest.mark.parametrize("content, match", [
+    (None, "not found"), ("{not json", "is not a saved controller"),
+    ('{"A": [[1.0]]}', "is not a saved controller")])
+def test_unreadable_controller_files_fail_before_any_case(tmp_path, content, match):
+    path = tmp_path / "k.json"
+    if content is not None:
+        path.write_text(content)
+    t0 = time.perf_counter()
+    with pytest.raises(InputError, match=f"controllers: .*{match}"):
+        run_sweep(SweepSpec(controllers=(str(path),), grid=(("m3", (40.0,)),)),
+                  tmp_path / "out", workers=0)
+    assert time.perf_counter() - t0 < 5.0  # no case ran (each takes a simulation)
+    assert not (tmp_path / "out").exists()
+
+
+# ----------------------------------------------------------------- rows
+
+
+def test_rows_are_the_simulators_numbers(reference):
+    """Each row against a direct call of the simulator and the Nyquist test."""
+    for row in (reference[4], reference[9]):
+        K = K_SIMPLE if row["controller"] != "passive" else None
+        p = SeatParameters(m3=row["m3"])
+        res = simulate(K, bump(t_end=0.6), delay=row["delay"], params=p, dt=SIM_STEP)
+        m = res.metrics()
+        assert row["peak_z3dd"] == m.peak_z3dd and row["peak_x1"] == m.peak_x1
+        assert row["wrms_z3dd"] == m.weighted_rms_z3dd and row["peak_u"] == m.peak_u
+        assert row["stable"] == (True if K is None else closed_loop_stable(K, row["delay"], p))
+        assert row["error"] is None and row["limit_ratio"] is None
+
+
+def test_limit_ratio_is_the_peak_over_that_cases_own_limit(tmp_path, controller_file):
+    from lmi_suspension.seat import bump_limit
+
+    spec = SweepSpec(controllers=(str(controller_file),), grid=(("m3", (40.0, 60.0)),),
+                     duration=1.5)
+    run_sweep(spec, tmp_path, workers=0, figures=False)
+    rows = read_results(tmp_path)[0].to_pylist()
+    limits = [bump_limit(bump(t_end=1.5), SeatParameters(m3=m)).certified_peak
+              for m in (40.0, 60.0)]
+    assert [r["limit_peak"] for r in rows] == pytest.approx(limits, rel=1e-9)
+    assert rows[0]["limit_peak"] != rows[1]["limit_peak"]
+    for r in rows:
+        assert r["limit_ratio"] == pytest.approx(r["peak_z3dd"] / r["limit_peak"], rel=1e-12)
+
+
+def test_a_failing_case_records_its_error_and_the_sweep_goes_on(tmp_path):
+    wrong = save_controller(tmp_path / "k1.json", control.ss([], [], [], [[1.0]]))  # 1 input
+    spec = SweepSpec(controllers=(str(wrong), "passive"), grid=(("m3", (40.0, 60.0)),),
+                     duration=0.3, limit=False)
+    res = run_sweep(spec, tmp_path / "out", workers=0, figures=False)
+    rows = read_results(tmp_path / "out")[0].to_pylist()
+    assert res.n_failed == 2 and len(rows) == 4
+    assert all("DimensionError" in r["error"] for r in rows[:2])
+    assert all(r["error"] is None and r["peak_z3dd"] > 0 for r in rows[2:])
+
+
+def test_table_metadata_holds_the_spec_and_versions(tmp_path, controller_file):
+    spec = _spec(controller_file, grid=(("m3", (50.0,)),))
+    res = run_sweep(spec, tmp_path, workers=0)
+    meta = pq.read_schema(res.table).metadata
+    assert SweepSpec.from_json(meta[b"lmi_suspension.spec"].decode()) == spec
+    versions = json.loads(meta[b"lmi_suspension.versions"])
+    assert versions["pyarrow"] and versions["numpy"] == np.__version__
+    assert [p.name for p in res.figures] == ["tradeoff.png"]  # one axis: no map
+
+
+def test_another_specs_directory_is_refused(tmp_path, controller_file):
+    run_sweep(_spec(controller_file, grid=(("m3", (50.0,)),)), tmp_path, workers=0,
+              figures=False)
+    with pytest.raises(ParameterError, match="another sweep"):
+        run_sweep(_spec(controller_file, grid=(("m3", (55.0,)),)), tmp_path, workers=0)
+
+
+# ----------------------------------------------------------------- resume
+
+
+def test_an_interrupted_sweep_resumes_where_it_stopped(tmp_path, controller_file, reference):
+    class Stop(Exception):
+        pass
+
+    def stop_after_two(k):
+        if k == 2:
+            raise Stop
+
+    spec = _spec(controller_file)
+    with pytest.raises(Stop):
+        run_sweep(spec, tmp_path, workers=0, batch_size=3, on_batch=stop_after_two)
+    assert not (tmp_path / "results.parquet").exists()
+    res = run_sweep(spec, tmp_path, workers=0, batch_size=3)
+    assert (res.n_skipped, res.n_run) == (6, 6)
+    assert _rows(tmp_path) == reference
+    again = run_sweep(spec, tmp_path, workers=0)
+    assert (again.n_skipped, again.n_run) == (12, 0)
+
+
+# ----------------------------------------------------------------- dask
+
+
+def test_local_cluster_of_two_processes_gives_the_same_rows_in_any_order(
+        tmp_path, controller_file, reference):
+    spec = _spec(controller_file)
+    res = run_sweep(spec, tmp_path / "a", workers=2, batch_size=2, shuffle_seed=3,
+                    figures=False)
+    assert res.workers == 2 and res.n_run == 12
+    assert _rows(tmp_path / "a") == reference
+    res1 = run_sweep(spec, tmp_path / "b", workers=1, batch_size=5, figures=False)
+    assert res1.workers == 1 and _rows(tmp_path / "b") == reference
+
+
+def _start(cmd, **kw):
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1")
+    return subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            env=env, **kw)
+
+
+def _wait_for(predicate, seconds=60.0):
+    t_end = time.monotonic() + seconds
+    while time.monotonic() < t_end:
+        if predicate():
+            return
+        time.sleep(0.2)
+    raise TimeoutError("the dask processes did not come up")
+
+
+@pytest.fixture
+def dask_processes(tmp_path):
+    """A ``dask scheduler`` and two ``dask worker`` processes (no nanny: a killed worker
+    stays dead), as separate processes on localhost."""
+    dask = [sys.executable, "-m", "dask"]  # the dask CLI of this interpreter
+    sched_file = tmp_path / "scheduler.json"
+    procs = [_start(dask + ["scheduler", "--host", "127.0.0.1", "--port", "0",
+                            "--no-dashboard", "--scheduler-file", str(sched_file)])]
+    try:
+        _wait_for(sched_file.exists)
+        address = json.loads(sched_file.read_text())["address"]
+        for _ in range(2):
+            procs.append(_start(dask + ["worker", address, "--nthreads", "1", "--no-nanny",
+                                        "--no-dashboard", "--host", "127.0.0.1"]))
+        from distributed import Client
+
+        with Client(address, timeout="20s") as c:
+            c.wait_for_workers(2, timeout=60)
+        yield address, procs[1:]
+    finally:
+        for p in procs:  # test processes: no state worth a graceful close (which
+            if p.poll() is None:  # took 20 s per process)
+                p.kill()
+        for p in procs:
+            p.wait(timeout=20)
+
+
+def test_a_running_scheduler_and_workers_started_apart(dask_processes, tmp_path,
+                                                       controller_file, reference):
+    address, _workers = dask_processes
+    res = run_sweep(_spec(controller_file), tmp_path, scheduler=address, batch_size=1,
+                    figures=False)
+    assert res.workers == 2 and res.n_run == 12
+    assert _rows(tmp_path) == reference
+
+
+def test_a_worker_killed_mid_sweep_loses_and_duplicates_nothing(dask_processes, tmp_path,
+                                                               controller_file, reference):
+    address, workers = dask_processes
+    killed = []
+
+    def kill_one(k):
+        if k == 1:  # the other worker is busy with its next batch now
+            workers[0].send_signal(signal.SIGKILL)
+            workers[0].wait(timeout=20)
+            killed.append(k)
+
+    res = run_sweep(_spec(controller_file), tmp_path, scheduler=address, batch_size=1,
+                    on_batch=kill_one, figures=False)
+    assert killed == [1] and res.n_run == 12 and res.n_failed == 0
+    rows = _rows(tmp_path)
+    assert [r["case"] for r in rows] == list(range(12))
+    assert rows == reference
+    parts = [pq.read_table(p, columns=["case"]).column("case").to_pylist()
+             for p in sorted((tmp_path / "parts").glob("*.parquet"))]
+    assert sorted(c for part in parts for c in part) == list(range(12))  # each case once
+
+
+# ----------------------------------------------------------------- CLI
+
+
+def test_cli_sweep_writes_table_and_figures(tmp_path, controller_file, capsys):
+    from lmi_suspension.cli import main
+
+    rc = main(["sweep", "--controller", str(controller_file), "--m3", "40:60:2",
+               "--delay", "0:0.3:3", "--duration", "0.6", "--no-limit", "--workers", "0",
+               "--out", str(tmp_path), "-q"])
+    out = capsys.readouterr().out
+    assert rc == 0 and "6 cases (6 run now" in out
+    rows = read_results(tmp_path)[0].to_pylist()
+    assert [r["delay"] for r in rows[:3]] == [0.0, 0.15, 0.3]
+    assert (tmp_path / "map-k.png").is_file() and (tmp_path / "tradeoff.png").is_file()
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["--m3", "30:70:0"], "m3: empty range"),
+    (["--param", "k9=1:2:3"], "k9: unknown parameter"),
+    (["--controller", "missing.json"], "controllers: file missing.json not found"),
+    (["--samples", "3", "--m3", "30:50:4"], "m3: with --samples give a range lo:hi")])
+def test_cli_sweep_bad_input_is_one_line_exit_2(tmp_path, argv, match, capsys):
+    from lmi_suspension.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["sweep", "--out", str(tmp_path / "o"), "--workers", "0"] + argv)
+    assert exc.value.code == 2
+    assert match in capsys.readouterr().err
