@@ -18,6 +18,7 @@ from lmi_suspension.errors import AssumptionError, ParameterError
 from lmi_suspension.io import load_controller
 from lmi_suspension.mu.dk import MusynIteration
 from lmi_suspension.seat.design import MuCheck, SeatMuDesign
+from lmi_suspension.sweep import read_results
 from lmi_suspension.seat import (
     SeatDesignOptions,
     bump,
@@ -139,7 +140,13 @@ def test_summary_has_every_controller_and_delay(run):
     assert data["mu"]["analysis"][1]["mu_peak"] == 0.8
     assert data["mu"]["peak_upper"] == pytest.approx(max(data["mu"]["upper"]))
     assert data["timings"]["total"] > 0
-    assert data["monte_carlo"]["n"] == len(data["monte_carlo"]["peak_z3dd"])
+    mc = data["monte_carlo"]
+    assert mc["n"] == len(mc["peak_z3dd"]) == len(mc["limit_ratio"])
+    # the Monte-Carlo is a sweep: its table beside the summary, the same numbers
+    rows = read_results(run.out / "monte_carlo")[0].to_pylist()
+    assert [r["peak_z3dd"] for r in rows] == mc["peak_z3dd"]
+    assert mc["worst"]["peak_z3dd"] == max(mc["peak_z3dd"]) and mc["sweep"]["failed"] == 0
+    assert all(30.0 <= r["m3"] <= 70.0 and 0.0 <= r["delay"] <= 0.025 for r in rows)
 
 
 @pytest.mark.slow

@@ -16,6 +16,7 @@ import dataclasses
 import json
 import logging
 import math
+import shutil
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -55,12 +56,55 @@ class _Settings:
     sim_dt: float
     limit_dt: float
     mc_n: int
+    #: Dask workers of the Monte-Carlo sweep (0: in this process)
+    mc_workers: int
 
 
 _FULL = _Settings(bump_t_end=3.0, noise_t_end=3.0, iso_t_end=3.0, road_dt=1e-3, sim_dt=2e-4,
-                  limit_dt=2e-3, mc_n=8)
+                  limit_dt=2e-3, mc_n=48, mc_workers=2)
 _QUICK = _Settings(bump_t_end=1.5, noise_t_end=1.0, iso_t_end=1.0, road_dt=1e-3, sim_dt=5e-4,
-                   limit_dt=5e-3, mc_n=2)
+                   limit_dt=5e-3, mc_n=4, mc_workers=0)
+
+
+#: the Monte-Carlo's uncertainty set: m3 over the paper's occupants, each stiffness ±20 %
+_MC_M3 = (30.0, 70.0)
+_MC_STIFFNESS_REL = 0.2
+
+
+def _monte_carlo(controller: Path, cfg: _Settings, delay_range, params, seed: int,
+                 nominal_limit: float, road) -> dict:
+    """The Monte-Carlo over the uncertainty set as a sweep (:mod:`lmi_suspension.sweep`):
+    ``cfg.mc_n`` cases, each with its own physical limit, on ``cfg.mc_workers`` Dask
+    workers; the table and its trade-off figure go to ``monte_carlo/`` beside the other
+    results.  Returns the summary's ``monte_carlo`` entry."""
+    from ..sweep import SweepSpec, read_results, run_sweep
+
+    ranges = [("m3", *_MC_M3)]
+    ranges += [(k, getattr(params, k) * (1 - _MC_STIFFNESS_REL),
+                getattr(params, k) * (1 + _MC_STIFFNESS_REL)) for k in ("k1", "k2", "k3")]
+    if delay_range[1] > delay_range[0]:
+        ranges.append(("delay", float(delay_range[0]), float(delay_range[1])))
+    spec = SweepSpec(controllers=(str(controller),), samples=cfg.mc_n, ranges=tuple(ranges),
+                     road="bump", duration=float(road.t[-1]), seed=seed)
+    out = controller.parent / "monte_carlo"
+    if out.exists():
+        shutil.rmtree(out)  # a new controller: the previous run's cases are not this one's
+    res = run_sweep(spec, out, workers=cfg.mc_workers)
+    rows = read_results(out)[0].to_pylist()
+    score = [r["peak_z3dd"] if r["stable"] and r["stable_sim"] else math.inf for r in rows]
+    worst = rows[int(np.argmax(score))]
+    return {
+        "n": cfg.mc_n, "m3_range": list(_MC_M3), "stiffness_rel": _MC_STIFFNESS_REL,
+        "delay_range": [float(d) for d in delay_range], "seed": seed,
+        "peak_z3dd": [r["peak_z3dd"] for r in rows],
+        "delays": [r.get("delay", float(delay_range[0])) for r in rows],
+        "limit_ratio": [r["limit_ratio"] for r in rows],
+        "worst": {k: v for k, v in worst.items() if k not in ("controller", "seconds")},
+        "worst_ratio_to_limit": worst["peak_z3dd"] / nominal_limit,
+        # (its wall time is the stage's, in "timings")
+        "sweep": {"workers": res.workers, "failed": res.n_failed,
+                  "table": "monte_carlo/results.parquet"},
+    }
 
 
 @dataclass(frozen=True)
@@ -262,7 +306,6 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         bump_limit,
         closed_loop_stable,
         iso8608_road,
-        monte_carlo,
         simulate,
         stability_delay_margin,
         white_noise,
@@ -421,24 +464,30 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
             iso_data["results"][label] = dict(delay=d, **dataclasses.asdict(res.metrics()))
     done(tok)
 
-    tok = stage("monte_carlo", f"Monte-Carlo over the uncertainty set ({cfg.mc_n} samples, "
-                f"µ controller) ...")
-    mc = monte_carlo(mu_design.K, road_bump, n=cfg.mc_n, rng=rng_mc,
-                     delay=(delays[0], delays[-1]), dt=dt if dt is not None else 1e-4,
-                     params=params)
-    worst_p = mc.params[mc.worst_index]
-    mc_data = {
-        "n": cfg.mc_n, "m3_range": [30.0, 70.0], "stiffness_rel": 0.2,
-        "delay_range": [delays[0], delays[-1]],
-        "peak_z3dd": mc.peak_z3dd, "delays": mc.delays,
-        "worst": dict(index=mc.worst_index, delay=float(mc.delays[mc.worst_index]),
-                      m3=worst_p.m3, k1=worst_p.k1, k2=worst_p.k2, k3=worst_p.k3,
-                      **dataclasses.asdict(mc.worst)),
-        "worst_ratio_to_limit": mc.worst.peak_z3dd / limit.peak,
+    # --- controller.json (the Monte-Carlo sweep reads it) -------------------------------
+    design_opts = getattr(getattr(mu_design, "aug", None), "options", None)
+    if design_opts is None:
+        design_opts = getattr(api, "DEFAULT_DESIGN", None)
+    musyn_opts = getattr(api, "DEFAULT_MUSYN", None)
+    metadata = {
+        "description": "µ-synthesis seat controller: y = [x1, x3] (m) -> u (N), sign of eq. (1)",
+        "mu_peak_upper": float(mu_design.mu_peak),
+        "mu_peak_lower": float(mu_design.mu_lower_peak),
+        "design_options": _jsonable(design_opts),
+        "musyn_options": _jsonable(musyn_opts),
+        "version": __version__,
     }
+    files.append(save_controller(out / "controller.json", mu_design.K, inputs=["x1", "x3"],
+                                 outputs=["u"], metadata=metadata))
+    tok = stage("monte_carlo", f"Monte-Carlo over the uncertainty set ({cfg.mc_n} samples, "
+                f"µ controller, {cfg.mc_workers or 'no'} Dask workers) ...")
+    mc_data = _monte_carlo(out / "controller.json", cfg, (delays[0], delays[-1]), params,
+                           int(rng_mc.integers(2**63)), limit.peak, road_bump)
+    files.append(out / "monte_carlo")  # results.parquet, tradeoff.png, spec.json, parts/
     done(tok)
-    say(f"  worst sample: peak |z3''| {mc.worst.peak_z3dd:.3f} m/s² "
-        f"(stable {mc.worst.stable})")
+    worst = mc_data["worst"]
+    say(f"  worst sample: peak |z3''| {worst['peak_z3dd']:.3f} m/s² "
+        f"(stable {worst['stable']})")
 
     # --- figures ---------------------------------------------------------------------
     tok = stage("figures", "writing figures ...")
@@ -487,21 +536,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     save(figures.plot_responses(iso_runs, "z3dd", title=road_iso.description), "iso_C_z3dd.png")
     done(tok)
 
-    # --- controller.json and summary.json ----------------------------------------------
-    design_opts = getattr(getattr(mu_design, "aug", None), "options", None)
-    if design_opts is None:
-        design_opts = getattr(api, "DEFAULT_DESIGN", None)
-    musyn_opts = getattr(api, "DEFAULT_MUSYN", None)
-    metadata = {
-        "description": "µ-synthesis seat controller: y = [x1, x3] (m) -> u (N), sign of eq. (1)",
-        "mu_peak_upper": float(mu_design.mu_peak),
-        "mu_peak_lower": float(mu_design.mu_lower_peak),
-        "design_options": _jsonable(design_opts),
-        "musyn_options": _jsonable(musyn_opts),
-        "version": __version__,
-    }
-    files.append(save_controller(out / "controller.json", mu_design.K, inputs=["x1", "x3"],
-                                 outputs=["u"], metadata=metadata))
+    # --- summary.json ---------------------------------------------------------------
     # per-iteration diagnostics without the controllers (the returned one is controller.json)
     history = [dataclasses.replace(h, K=None)
                for h in getattr(getattr(mu_design, "musyn", None), "history", ())]

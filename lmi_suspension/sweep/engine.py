@@ -286,7 +286,7 @@ def _run_dask(out, batches, controllers, spec, settings, keys, scheduler, n_work
         # one BLAS thread per worker process: two workers of two threads each on two
         # cores oversubscribe them (FACTS.md, "Sweeps")
         cluster = LocalCluster(n_workers=n_workers, threads_per_worker=1, processes=True,
-                               dashboard_address=None, silence_logs=logging.ERROR,
+                               dashboard_address=":0", silence_logs=logging.ERROR,
                                env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1",
                                     "MKL_NUM_THREADS": "1"})
         client = Client(cluster)
