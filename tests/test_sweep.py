@@ -354,3 +354,49 @@ def test_cli_sweep_bad_input_is_one_line_exit_2(tmp_path, argv, match, capsys):
         main(["sweep", "--out", str(tmp_path / "o"), "--workers", "0"] + argv)
     assert exc.value.code == 2
     assert match in capsys.readouterr().err
+
+
+# ----------------------------------------------------------------- per-case designs
+
+
+def test_design_entry_synthesises_one_controller_per_distinct_seat(tmp_path, monkeypatch):
+    """Every case of one seat runs the µ controller designed for that seat, designed once."""
+    from lmi_suspension.seat import design as design_module
+
+    calls = []
+    real = design_module.design_mu_controller
+
+    def counting(*args, **kwargs):
+        calls.append(kwargs["params"].m3)
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(design_module, "design_mu_controller", counting)
+    spec = SweepSpec(controllers=("design",), grid=(("m3", (60.0,)), ("delay", (0.0, 0.02))),
+                     duration=0.5, limit=False)
+    res = run_sweep(spec, tmp_path, workers=0, figures=False)
+    assert calls == [60.0] and res.n_failed == 0
+    rows = read_results(tmp_path)[0].to_pylist()
+    # independent route: the same design called directly, simulated directly
+    K = real(params=SeatParameters(m3=60.0), rng=np.random.default_rng(spec.seed)).K
+    for row in rows:
+        m = simulate(K, bump(t_end=0.5), delay=row["delay"], params=SeatParameters(m3=60.0),
+                     dt=SIM_STEP).metrics()
+        assert row["peak_z3dd"] == pytest.approx(m.peak_z3dd, rel=1e-9)
+        assert row["stable"] == closed_loop_stable(K, row["delay"], SeatParameters(m3=60.0))
+
+
+def test_a_failed_design_marks_its_cases_and_the_sweep_goes_on(tmp_path, monkeypatch):
+    from lmi_suspension.errors import InfeasibleError
+    from lmi_suspension.seat import design as design_module
+
+    def failing(*args, **kwargs):  # the injected failure
+        raise InfeasibleError("no stabilising controller")
+
+    monkeypatch.setattr(design_module, "design_mu_controller", failing)
+    spec = SweepSpec(controllers=("design", "passive"), grid=(("m3", (50.0, 60.0)),),
+                     duration=0.3, limit=False)
+    res = run_sweep(spec, tmp_path, workers=0, figures=False)
+    rows = read_results(tmp_path)[0].to_pylist()
+    assert res.n_failed == 2
+    assert all("design failed: InfeasibleError" in r["error"] for r in rows[:2])
+    assert all(r["error"] is None for r in rows[2:])

@@ -21,9 +21,10 @@ from ..seat import (
     simulate,
     white_noise,
 )
-from .spec import PASSIVE, PLANT_AXES, ROADS, SIM_STEP, Case
+from .spec import DESIGN, PASSIVE, PLANT_AXES, ROADS, SIM_STEP, Case
 
-__all__ = ["evaluate_batch", "evaluate_case", "limit_key", "compute_limit", "METRIC_COLUMNS"]
+__all__ = ["METRIC_COLUMNS", "compute_design", "compute_limit", "design_key", "error_row", "evaluate_batch",
+           "evaluate_case", "limit_key"]
 
 #: the result columns of every row, after the case's index, controller and axis values
 METRIC_COLUMNS = ("delay_used", "stable", "stable_sim", "peak_z3dd", "rms_z3dd",
@@ -70,6 +71,36 @@ def compute_limit(key: tuple) -> float:
         return float("nan")
 
 
+def design_key(case: Case) -> tuple | None:
+    """What the per-case µ design of ``case`` depends on (its seat), or None where the
+    case runs a saved controller or none."""
+    if case.controller != DESIGN:
+        return None
+    return tuple(sorted((k, float(v)) for k, v in case.values.items() if k in PLANT_AXES))
+
+
+def compute_design(key: tuple, seed: int) -> dict:
+    """The µ controller designed for the seat of a :func:`design_key`, as a saved dict (its
+    µ peak in the metadata), or ``{"error": ...}`` where the design fails."""
+    from ..io import controller_to_dict
+    from ..seat.design import design_mu_controller
+
+    try:
+        d = design_mu_controller(params=_params(dict(key)), rng=np.random.default_rng(seed))
+    except Exception as exc:  # the cases of this seat record it; the sweep goes on
+        return {"error": f"design failed: {type(exc).__name__}: {exc}"}
+    return controller_to_dict(d.K, inputs=["x1", "x3"], outputs=["u"],
+                              metadata={"mu_peak": float(d.mu_peak)})
+
+
+def error_row(case: Case, message: str) -> dict:
+    """The row of a case that could not be evaluated."""
+    row = {"case": case.index, "controller": case.controller, **case.values}
+    row.update({c: None for c in METRIC_COLUMNS})
+    row.update(error=message, seconds=0.0)
+    return row
+
+
 def evaluate_case(case: Case, K, road: str, settings: dict, limit: float | None) -> dict:
     """The row of one case (``K`` the controller, None for the passive seat)."""
     t0 = time.perf_counter()
@@ -100,17 +131,25 @@ def evaluate_case(case: Case, K, road: str, settings: dict, limit: float | None)
 
 
 def evaluate_batch(cases: list, controllers: dict, road: str, settings: dict,
-                   limits: dict) -> list[dict]:
+                   limits: dict, designs: dict | None = None) -> list[dict]:
     """Rows of a batch of cases.  ``controllers`` maps each controller entry to its saved
-    dict (rebuilt exactly here, on the worker); ``limits`` maps limit keys to peaks."""
+    dict (rebuilt exactly here, on the worker); ``limits`` maps limit keys to peaks and
+    ``designs`` design keys to saved dicts (:func:`compute_design`)."""
     from ..io import controller_from_dict
 
-    built = {name: (None if name == PASSIVE else controller_from_dict(d))
-             for name, d in controllers.items()}
+    built = {name: controller_from_dict(d) for name, d in controllers.items()
+             if name not in (PASSIVE, DESIGN)}
+    built[PASSIVE] = None
+    for key, d in (designs or {}).items():
+        built[key] = d if "error" in d else controller_from_dict(d)
     rows = []
     for case in cases:
         key = limit_key(case, road, settings)
-        rows.append(evaluate_case(case, built[case.controller], road, settings,
-                                  None if key is None else limits.get(key)))
+        limit = None if key is None else limits.get(key)
+        K = built[design_key(case)] if case.controller == DESIGN else built[case.controller]
+        if isinstance(K, dict):  # a failed design
+            rows.append(error_row(case, K["error"]))
+            continue
+        rows.append(evaluate_case(case, K, road, settings, limit))
     return rows
 

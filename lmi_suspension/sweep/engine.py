@@ -26,8 +26,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..errors import InputError, LmiSuspensionError, ParameterError
-from .case import compute_limit, evaluate_batch, limit_key
-from .spec import PASSIVE, SweepSpec
+from .case import (
+    compute_design,
+    compute_limit,
+    design_key,
+    error_row,
+    evaluate_batch,
+    limit_key,
+)
+from .spec import DESIGN, PASSIVE, SweepSpec
 
 __all__ = ["SweepResult", "run_sweep", "read_results"]
 
@@ -101,7 +108,7 @@ def _load_controllers(spec: SweepSpec) -> dict:
 
     out = {}
     for name in spec.controllers:
-        if name == PASSIVE:
+        if name in (PASSIVE, DESIGN):
             out[name] = None
             continue
         path = Path(name)
@@ -223,14 +230,15 @@ def run_sweep(spec: SweepSpec, out, *, scheduler: str | None = None, workers: in
             random.Random(shuffle_seed).shuffle(batches)
         keys = sorted({k for c in pending
                        if spec.limit and (k := limit_key(c, spec.road, settings)) is not None})
-        logger.info("sweep: %d cases (%d done before), %d batches, %d limits", len(pending),
-                    len(done), len(batches), len(keys))
+        designs = sorted({k for c in pending if (k := design_key(c)) is not None})
+        logger.info("sweep: %d cases (%d done before), %d batches, %d limits, %d designs",
+                    len(pending), len(done), len(batches), len(keys), len(designs))
         if scheduler is None and n_workers == 0:
             compute, n_workers = _run_here(out, batches, controllers, spec, settings, keys,
-                                           progress, on_batch), 0
+                                           designs, progress, on_batch), 0
         else:
             compute, n_workers = _run_dask(out, batches, controllers, spec, settings, keys,
-                                           scheduler, n_workers, progress, on_batch)
+                                           designs, scheduler, n_workers, progress, on_batch)
     table, n_failed = _consolidate(out, spec)
     figs = ()
     if figures:
@@ -247,12 +255,14 @@ def _part_name(batch: list) -> str:
     return f"cases-{batch[0].index:08d}-{batch[-1].index:08d}"
 
 
-def _run_here(out, batches, controllers, spec, settings, keys, progress, on_batch) -> float:
+def _run_here(out, batches, controllers, spec, settings, keys, designs, progress,
+              on_batch) -> float:
     limits = {k: compute_limit(k) for k in keys}
+    made = {k: compute_design(k, spec.seed) for k in designs}
     total, n, compute = sum(len(b) for b in batches), 0, 0.0
     for k, batch in enumerate(batches, start=1):
         rows = evaluate_batch(batch, _used(controllers, batch), spec.road, settings,
-                              _needed(limits, batch, spec, settings))
+                              _needed(limits, batch, spec, settings), _designs(made, batch))
         _write_part(out, rows, _part_name(batch))
         compute += sum(r["seconds"] for r in rows)
         n += len(batch)
@@ -264,7 +274,13 @@ def _run_here(out, batches, controllers, spec, settings, keys, progress, on_batc
 
 
 def _used(controllers: dict, batch: list) -> dict:
-    return {c.controller: controllers[c.controller] for c in batch}
+    return {c.controller: controllers[c.controller] for c in batch
+            if c.controller not in (PASSIVE, DESIGN)}
+
+
+def _designs(designs: dict, batch: list) -> dict:
+    keys = {design_key(c) for c in batch}
+    return {k: designs[k] for k in keys if k is not None}
 
 
 def _needed(limits: dict, batch: list, spec: SweepSpec, settings: dict) -> dict:
@@ -274,7 +290,7 @@ def _needed(limits: dict, batch: list, spec: SweepSpec, settings: dict) -> dict:
     return {k: limits[k] for k in keys if k is not None}
 
 
-def _run_dask(out, batches, controllers, spec, settings, keys, scheduler, n_workers,
+def _run_dask(out, batches, controllers, spec, settings, keys, designs, scheduler, n_workers,
               progress, on_batch) -> tuple[float, int]:
     try:
         from distributed import Client, LocalCluster, as_completed
@@ -294,14 +310,19 @@ def _run_dask(out, batches, controllers, spec, settings, keys, scheduler, n_work
         client = Client(scheduler, timeout="10s")
     try:
         n_workers = len(client.scheduler_info()["workers"]) or n_workers
+        # each distinct limit LP and design once, as tasks of their own; the batches that
+        # need them wait for them (Dask passes the results in place of the futures)
         limit_futs = {k: client.submit(compute_limit, k, pure=False) for k in keys}
+        design_futs = {k: client.submit(compute_design, k, spec.seed, pure=False)
+                       for k in designs}
         futures = {}
         for batch in batches:
             needed = {} if not spec.limit else {
                 k: limit_futs[k] for k in {limit_key(c, spec.road, settings) for c in batch}
                 if k is not None}
             fut = client.submit(evaluate_batch, batch, _used(controllers, batch), spec.road,
-                                settings, needed, pure=False, retries=2)
+                                settings, needed, _designs(design_futs, batch), pure=False,
+                                retries=2)
             futures[fut] = batch
         total, n, compute = sum(len(b) for b in batches), 0, 0.0
         for k, fut in enumerate(as_completed(list(futures)), start=1):
@@ -310,7 +331,7 @@ def _run_dask(out, batches, controllers, spec, settings, keys, scheduler, n_work
                 rows = fut.result()
             except Exception as exc:  # the batch itself failed (killed workers, ...)
                 logger.warning("sweep: batch %s failed: %s", _part_name(batch), exc)
-                rows = [_error_row(c, exc) for c in batch]
+                rows = [error_row(c, f"{type(exc).__name__}: {exc}") for c in batch]
             _write_part(out, rows, _part_name(batch))
             compute += sum(r["seconds"] or 0.0 for r in rows)
             n += len(batch)
@@ -323,15 +344,6 @@ def _run_dask(out, batches, controllers, spec, settings, keys, scheduler, n_work
         client.close()
         if cluster is not None:
             cluster.close()
-
-
-def _error_row(case, exc) -> dict:
-    from .case import METRIC_COLUMNS
-
-    row = {"case": case.index, "controller": case.controller, **case.values}
-    row.update({c: None for c in METRIC_COLUMNS})
-    row.update(error=f"{type(exc).__name__}: {exc}", seconds=0.0)
-    return row
 
 
 def _consolidate(out: Path, spec: SweepSpec) -> tuple[Path, int]:

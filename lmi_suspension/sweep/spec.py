@@ -29,7 +29,7 @@ import numpy as np
 from ..errors import InputError, ParameterError
 from ..seat.params import SeatParameters
 
-__all__ = ["SweepSpec", "Case", "parse_range", "PLANT_AXES", "ROADS", "PASSIVE"]
+__all__ = ["DESIGN", "PASSIVE", "PLANT_AXES", "ROADS", "Case", "SweepSpec", "parse_range"]
 
 #: the seat's parameters a sweep may vary (the delay bounds of SeatParameters are the
 #: design's, not a case's: a case has one delay)
@@ -42,6 +42,10 @@ ROADS = {
 }
 #: the controller entry that means "no controller" (the passive seat)
 PASSIVE = "passive"
+#: the controller entry that means "a µ controller designed for this case's seat"
+#: (:func:`~lmi_suspension.seat.design.design_mu_controller` with the paper's weights and
+#: uncertainty, once per distinct seat of the sweep)
+DESIGN = "design"
 #: the simulation step of every case, s: a delay is rounded to it
 SIM_STEP = 1e-4
 #: the default record lengths, s (the bump's tail lets the seat settle)
@@ -139,8 +143,11 @@ class SweepSpec:
     Attributes
     ----------
     controllers : tuple of str
-        Saved controller files (:func:`~lmi_suspension.io.save_controller`), or
-        ``"passive"``; each case runs one of them.
+        Saved controller files (:func:`~lmi_suspension.io.save_controller`),
+        ``"passive"`` (no controller), or ``"design"``: a µ controller synthesised for the
+        case's own seat (:func:`~lmi_suspension.seat.design.design_mu_controller`, the
+        paper's weights and uncertainty; about 10 s each, once per distinct seat); each
+        case runs one of them.
     grid : tuple of (str, tuple of float)
         Axes of a full grid, outermost first.  Axes not named keep their default
         (Table 1, no delay, the road's defaults).
@@ -341,8 +348,8 @@ class SweepSpec:
         ctrls = data.get("controllers", [PASSIVE])
         if isinstance(ctrls, str):
             ctrls = [ctrls]
-        ctrls = [c if c == PASSIVE or base is None or Path(c).is_absolute() else str(base / c)
-                 for c in ctrls]
+        ctrls = [c if c in (PASSIVE, DESIGN) or base is None or Path(c).is_absolute()
+                 else str(base / c) for c in ctrls]
         grid = tuple((str(n), parse_range(v, str(n)))
                      for n, v in dict(data.get("grid", {})).items())
         mc = dict(data.get("monte_carlo", {}))
