@@ -141,7 +141,7 @@ def test_summary_has_every_controller_and_delay(run):
     assert data["mu"]["peak_upper"] == pytest.approx(max(data["mu"]["upper"]))
     assert data["timings"]["total"] > 0
     mc = data["monte_carlo"]
-    assert mc["n"] == len(mc["peak_z3dd"]) == len(mc["limit_ratio"])
+    assert mc["n"] == len(mc["peak_z3dd"]) == len(mc["delays"])
     # the Monte-Carlo is a sweep: its table beside the summary, the same numbers
     rows = read_results(run.out / "monte_carlo")[0].to_pylist()
     assert [r["peak_z3dd"] for r in rows] == mc["peak_z3dd"]

@@ -385,6 +385,17 @@ def test_design_entry_synthesises_one_controller_per_distinct_seat(tmp_path, mon
         assert row["stable"] == closed_loop_stable(K, row["delay"], SeatParameters(m3=60.0))
 
 
+def test_step_sets_the_simulation_and_the_delay_rounding(tmp_path):
+    spec = SweepSpec(grid=(("delay", (0.0123,)),), duration=0.4, limit=False, step=5e-4)
+    assert spec.cases()[0].values["delay"] == round(0.0123 / 5e-4) * 5e-4
+    run_sweep(spec, tmp_path, workers=0, figures=False)
+    row = read_results(tmp_path)[0].to_pylist()[0]
+    m = simulate(None, bump(t_end=0.4), delay=row["delay"], dt=5e-4).metrics()
+    assert row["peak_z3dd"] == m.peak_z3dd and row["delay_used"] == row["delay"]
+    with pytest.raises(ParameterError, match="step"):
+        SweepSpec(step=0.0)
+
+
 def test_a_failed_design_marks_its_cases_and_the_sweep_goes_on(tmp_path, monkeypatch):
     from lmi_suspension.errors import InfeasibleError
     from lmi_suspension.seat import design as design_module

@@ -21,7 +21,7 @@ from ..seat import (
     simulate,
     white_noise,
 )
-from .spec import DESIGN, PASSIVE, PLANT_AXES, ROADS, SIM_STEP, Case
+from .spec import DESIGN, PASSIVE, PLANT_AXES, ROADS, Case
 
 __all__ = ["METRIC_COLUMNS", "compute_design", "compute_limit", "design_key", "error_row", "evaluate_batch",
            "evaluate_case", "limit_key"]
@@ -102,7 +102,8 @@ def error_row(case: Case, message: str) -> dict:
 
 
 def evaluate_case(case: Case, K, road: str, settings: dict, limit: float | None) -> dict:
-    """The row of one case (``K`` the controller, None for the passive seat)."""
+    """The row of one case (``K`` the controller, None for the passive seat;
+    ``settings`` the road's, with the simulation ``step``)."""
     t0 = time.perf_counter()
     row = {"case": case.index, "controller": case.controller, **case.values}
     row.update({c: None for c in METRIC_COLUMNS})
@@ -110,7 +111,7 @@ def evaluate_case(case: Case, K, road: str, settings: dict, limit: float | None)
         p = _params(case.values)
         delay = float(case.values.get("delay", 0.0))
         r = _road(road, settings, case.values, case.rng())
-        res = simulate(K, r, delay=delay, params=p, dt=SIM_STEP)
+        res = simulate(K, r, delay=delay, params=p, dt=settings["step"])
         m = res.metrics()
         stable_lin = True if K is None else bool(closed_loop_stable(K, delay, p))
         peak = float(m.peak_z3dd)

@@ -10,7 +10,7 @@ Axes (names of a grid axis or of a Monte-Carlo range):
 
 * the fields of :class:`~lmi_suspension.seat.SeatParameters` (``m1``, ``m21``, ``m22``,
   ``m3``, ``c1`` … ``k3``, ``z_max``, ``u_max``);
-* ``delay``: the actuator delay, s (rounded to the simulation step, 0.1 ms);
+* ``delay``: the actuator delay, s (rounded to the simulation step, 0.1 ms by default);
 * the road's parameters: ``height`` (m), ``length`` (m) and ``speed_kmh`` of the bump;
   ``speed_kmh`` of the ISO 8608 road; ``psd`` ((m/s)²/Hz) of the white floor velocity.
 """
@@ -46,7 +46,7 @@ PASSIVE = "passive"
 #: (:func:`~lmi_suspension.seat.design.design_mu_controller` with the paper's weights and
 #: uncertainty, once per distinct seat of the sweep)
 DESIGN = "design"
-#: the simulation step of every case, s: a delay is rounded to it
+#: the default simulation step, s (the simulator's own default)
 SIM_STEP = 1e-4
 #: the default record lengths, s (the bump's tail lets the seat settle)
 _DEFAULT_DURATION = {"bump": 3.0, "iso8608": 5.0, "noise": 5.0}
@@ -169,6 +169,9 @@ class SweepSpec:
         Compute each case's physical limit (bump only: the clairvoyant LP of
         :func:`~lmi_suspension.seat.bump_limit`, once per distinct seat and bump) and the
         ``limit_ratio`` column.
+    step : float
+        Simulation step, s (0.1 ms); every delay is rounded to a multiple of it.  The
+        cost of a case is proportional to ``duration / step``.
     """
 
     controllers: tuple = (PASSIVE,)
@@ -180,6 +183,7 @@ class SweepSpec:
     duration: float | None = None
     seed: int = 0
     limit: bool = True
+    step: float = SIM_STEP
 
     def __post_init__(self):
         if self.road not in ROADS:
@@ -214,6 +218,10 @@ class SweepSpec:
                                               and self.duration > 0):
             raise ParameterError(f"duration must be a positive number of seconds, "
                                  f"got {self.duration!r}")
+        if not (isinstance(self.step, (int, float)) and math.isfinite(self.step)
+                and 1e-6 <= self.step <= 1e-2):
+            raise ParameterError(f"step must be a simulation step in [1e-6, 1e-2] s, "
+                                 f"got {self.step!r}")
         if self.n_cases > _MAX_CASES:
             raise ParameterError(f"{self.n_cases} cases exceed the bound of {_MAX_CASES}")
         for name, value in self.grid:
@@ -276,17 +284,19 @@ class SweepSpec:
                         for name, lo, hi in self.ranges:
                             values[name] = float(rng.uniform(lo, hi))
                     if "delay" in values:
-                        values["delay"] = round(values["delay"] / SIM_STEP) * SIM_STEP
+                        values["delay"] = round(values["delay"] / self.step) * self.step
                     out.append(case)
                     k += 1
         return out
 
     def road_settings(self) -> dict:
-        """The road's parameters with the fixed options applied (before the case's own)."""
+        """The road's parameters with the fixed options applied (before the case's own),
+        the record's ``duration`` and the simulation ``step``."""
         settings = dict(_DEFAULT_ROAD[self.road])
         settings.update(dict(self.road_options))
         settings["duration"] = (_DEFAULT_DURATION[self.road] if self.duration is None
                                 else float(self.duration))
+        settings["step"] = float(self.step)
         return settings
 
     # ------------------------------------------------------------------ I/O
@@ -302,7 +312,8 @@ class SweepSpec:
                    samples=int(d["samples"]),
                    ranges=tuple((n, float(lo), float(hi)) for n, lo, hi in d["ranges"]),
                    road=d["road"], road_options=tuple((n, v) for n, v in d["road_options"]),
-                   duration=d["duration"], seed=int(d["seed"]), limit=bool(d["limit"]))
+                   duration=d["duration"], seed=int(d["seed"]), limit=bool(d["limit"]),
+                   step=float(d.get("step", SIM_STEP)))
 
     @classmethod
     def from_toml(cls, path) -> SweepSpec:
@@ -339,8 +350,8 @@ class SweepSpec:
     @classmethod
     def from_mapping(cls, data: dict, base: Path | None = None) -> SweepSpec:
         """A spec from a TOML-like mapping (unknown keys are errors naming the key)."""
-        allowed = {"controllers", "road", "duration", "seed", "limit", "road_options", "grid",
-                   "monte_carlo"}
+        allowed = {"controllers", "road", "duration", "seed", "limit", "step", "road_options",
+                   "grid", "monte_carlo"}
         for key in data:
             if key not in allowed:
                 raise ParameterError(f"{key}: unknown key of a sweep spec "
@@ -363,5 +374,5 @@ class SweepSpec:
                    road=str(data.get("road", "bump")),
                    road_options=tuple(dict(data.get("road_options", {})).items()),
                    duration=data.get("duration"), seed=int(data.get("seed", 0)),
-                   limit=bool(data.get("limit", True)))
+                   limit=bool(data.get("limit", True)), step=data.get("step", SIM_STEP))
 
