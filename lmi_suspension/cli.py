@@ -1,4 +1,4 @@
-"""Command line: ``lmi-suspension model | reproduce | simulate | sweep``."""
+"""Command line: ``lmi-suspension model | reproduce | simulate | sweep | export``."""
 
 from __future__ import annotations
 
@@ -27,18 +27,49 @@ def _cmd_model(args: argparse.Namespace) -> int:
     return 0
 
 
-def _progress(message: str) -> None:
-    sys.stderr.write(message + "\n")
-    sys.stderr.flush()
+class _StageBar:
+    """``reproduce``'s progress as a bar over its stages: a message that does not start
+    with a space opens the next stage, an indented one (a D-K iteration's µ bound, a
+    limit, a margin) is shown beside the bar."""
+
+    def __init__(self, stages):
+        from tqdm import tqdm
+
+        self._bar = tqdm(total=len(stages), unit="stage", file=sys.stderr,
+                         dynamic_ncols=True, bar_format="{desc} {bar} {n_fmt}/{total_fmt} "
+                         "stages [{elapsed}<{remaining}] {postfix}")
+        self._started = 0
+
+    def __call__(self, message: str) -> None:
+        if message.startswith("done in"):
+            return
+        if not message.startswith(" "):
+            if self._started:
+                self._bar.update(1)
+            self._started += 1
+            self._bar.set_description_str(message.rstrip(". "))
+            self._bar.set_postfix_str("")
+        else:
+            self._bar.set_postfix_str(" ".join(message.split()), refresh=True)
+
+    def close(self) -> None:
+        if self._started:
+            self._bar.update(self._bar.total - self._bar.n)
+        self._bar.close()
 
 
 def _cmd_reproduce(args: argparse.Namespace) -> int:
     import numpy as np
 
-    from .report.reproduce import comparison_table, reproduce
+    from .report.reproduce import STAGES, comparison_table, reproduce
 
-    summary = reproduce(args.out, progress=_progress, rng=np.random.default_rng(args.seed),
-                        quick=args.quick)
+    bar = None if args.quiet or not sys.stderr.isatty() else _StageBar(STAGES)
+    try:
+        summary = reproduce(args.out, progress=bar, rng=np.random.default_rng(args.seed),
+                            quick=args.quick)
+    finally:
+        if bar is not None:
+            bar.close()
     sys.stdout.write(comparison_table(summary) + "\n")
     return 0
 
@@ -114,6 +145,33 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
               f"(z_max = {m.z_max} m)\n")
     out.write(f"  {'stable (simulation)':<22} {'yes' if m.stable else 'NO':>12}\n")
     out.write(f"  {'stable (Nyquist)':<22} {'yes' if linear else 'NO':>12}\n")
+    return 0
+
+
+def _cmd_export(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .errors import InputError
+    from .io import load_controller, save_controller, save_controller_mat
+
+    src = Path(args.controller)
+    if not src.is_file():
+        raise InputError(f"controller file {src} not found")
+    try:
+        K, metadata = load_controller(src)
+    except (KeyError, TypeError, IndexError) as exc:
+        raise InputError(f"{src} is not a saved controller ({type(exc).__name__}: {exc})") \
+            from exc
+    out = Path(args.out)
+    if args.format == "mat":
+        save_controller_mat(out, K, ts=args.ts, metadata=metadata)
+    else:
+        if args.ts is not None:
+            raise InputError("--ts: a JSON controller is continuous-time; use --format mat")
+        save_controller(out, K, metadata=metadata)
+    sys.stdout.write(f"wrote {out} ({K.nstates} states, inputs {list(K.input_labels)}, "
+                     f"outputs {list(K.output_labels)}"
+                     + (f", discretised at Ts = {args.ts} s" if args.ts else "") + ")\n")
     return 0
 
 
@@ -221,6 +279,9 @@ def build_parser() -> argparse.ArgumentParser:
     p_rep.add_argument("--quick", action="store_true",
                        help="short runs and two delays (a smoke test, rough figures)")
     p_rep.add_argument("--seed", type=int, default=0, help="seed of every random number (0)")
+    p_rep.add_argument("-q", "--quiet", action="store_true",
+                       help="no progress bar (there is none either when stderr is not a "
+                            "terminal; -v logs the stages)")
     p_rep.set_defaults(func=_cmd_reproduce)
 
     p_sim = sub.add_parser("simulate", help="simulate a saved controller on a road")
@@ -267,6 +328,15 @@ def build_parser() -> argparse.ArgumentParser:
                       help="worker processes of the local cluster (default 2; 0: no Dask)")
     p_sw.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p_sw.set_defaults(func=_cmd_sweep)
+
+    p_ex = sub.add_parser("export", help="write a saved controller as a MATLAB .mat file "
+                          "(A, B, C, D, InputName, OutputName; Ts when discretised) or JSON")
+    p_ex.add_argument("--controller", required=True, help="controller JSON (save_controller)")
+    p_ex.add_argument("--format", choices=("mat", "json"), default="mat")
+    p_ex.add_argument("--out", required=True, help="the file to write")
+    p_ex.add_argument("--ts", type=float, default=None,
+                      help="discretise (zero-order hold) at this sample time, s (mat only)")
+    p_ex.set_defaults(func=_cmd_export)
     return parser
 
 

@@ -1,4 +1,4 @@
-"""Saving and loading controllers as JSON, exactly.
+"""Saving and loading controllers as JSON, exactly, and exporting them as MATLAB files.
 
 A saved controller is a continuous-time state-space system with keys ``A``, ``B``, ``C``,
 ``D`` (lists of rows), ``inputs``, ``outputs`` and free-form ``metadata``. Python's ``json``
@@ -17,7 +17,8 @@ import numpy as np
 from .errors import DimensionError, InputError
 from .lti.checks import as_finite_array, as_statespace
 
-__all__ = ["controller_to_dict", "controller_from_dict", "save_controller", "load_controller"]
+__all__ = ["controller_to_dict", "controller_from_dict", "save_controller", "load_controller",
+           "save_controller_mat", "load_controller_mat"]
 
 FORMAT = "lmi_suspension.controller/1"
 
@@ -115,3 +116,97 @@ def load_controller(path) -> tuple[control.StateSpace, dict]:
     if not isinstance(data, dict):
         raise InputError(f"{path} does not hold a controller object")
     return controller_from_dict(data), dict(data.get("metadata", {}))
+
+
+def save_controller_mat(path, K, *, inputs=None, outputs=None, ts: float | None = None,
+                        metadata=None) -> Path:
+    """Write ``K`` as a MATLAB ``.mat`` file (``scipy.io.savemat``) for Simulink, dSPACE or
+    a test rig.
+
+    Variables: ``A``, ``B``, ``C``, ``D`` (doubles, so the file holds the same IEEE-754
+    numbers as the controller), ``InputName`` and ``OutputName`` (cell arrays of
+    strings), and, for a discrete realization, ``Ts``; a ``description`` string holds the
+    metadata as JSON.  In MATLAB: ``s = load(path); K = ss(s.A, s.B, s.C, s.D)`` (add
+    ``s.Ts`` for the discrete one) and ``K.InputName = s.InputName``.
+
+    Parameters
+    ----------
+    path : path-like
+        The ``.mat`` file.
+    K : control.StateSpace
+        Continuous-time controller.
+    inputs, outputs : list of str, optional
+        Names (default: the controller's labels).
+    ts : float, optional
+        Write the zero-order-hold discretisation at this sample time, s, instead
+        (``control.c2d``, method ``"zoh"``).
+    metadata : dict, optional
+        Stored as JSON text in ``description``.
+
+    Examples
+    --------
+    >>> import control, tempfile, pathlib
+    >>> from lmi_suspension.io import save_controller_mat, load_controller_mat
+    >>> K = control.ss([[-1.0]], [[1.0, 0.5]], [[2.0]], [[0.0, 0.1]])
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "K.mat"
+    >>> _ = save_controller_mat(path, K, inputs=["x1", "x3"], outputs=["u"])
+    >>> K2, names = load_controller_mat(path)
+    >>> bool((K2.A == K.A).all() and (K2.D == K.D).all()), names
+    (True, (['x1', 'x3'], ['u']))
+    """
+    import scipy.io
+
+    d = controller_to_dict(K, inputs=inputs, outputs=outputs, metadata=metadata)
+    n, ny, nu = len(d["A"]), len(d["inputs"]), len(d["outputs"])
+    A = np.array(d["A"], dtype=float).reshape(n, n)
+    B = np.array(d["B"], dtype=float).reshape(n, ny)
+    C = np.array(d["C"], dtype=float).reshape(nu, n)
+    D = np.array(d["D"], dtype=float).reshape(nu, ny)
+    data = {"A": A, "B": B, "C": C, "D": D,
+            "InputName": np.array(d["inputs"], dtype=object).reshape(-1, 1),
+            "OutputName": np.array(d["outputs"], dtype=object).reshape(-1, 1),
+            "description": json.dumps(d["metadata"], default=_json_default)}
+    if ts is not None:
+        ts = float(ts)
+        if not (np.isfinite(ts) and ts > 0):
+            raise InputError(f"ts must be a positive sample time in seconds, got {ts!r}")
+        Kd = control.c2d(control.ss(A, B, C, D), ts, method="zoh")
+        data.update(A=np.asarray(Kd.A, dtype=float).reshape(n, n),
+                    B=np.asarray(Kd.B, dtype=float).reshape(n, ny),
+                    C=np.asarray(Kd.C, dtype=float).reshape(nu, n),
+                    D=np.asarray(Kd.D, dtype=float).reshape(nu, ny), Ts=ts)
+    path = Path(path)
+    scipy.io.savemat(path, data, do_compression=False, oned_as="column")
+    return path
+
+
+def load_controller_mat(path) -> tuple[control.StateSpace, tuple[list, list]]:
+    """Read a file written by :func:`save_controller_mat`: the controller (discrete when
+    the file has ``Ts``) and its ``(input names, output names)``."""
+    import scipy.io
+
+    path = Path(path)
+    try:
+        m = scipy.io.loadmat(path)
+    except (OSError, ValueError, scipy.io.matlab.MatReadError) as exc:
+        raise InputError(f"{path} is not a readable .mat file: {exc}") from exc
+    try:
+        A, B, C, D = (np.atleast_2d(np.asarray(m[k], dtype=float)) for k in "ABCD")
+        names = tuple([str(np.ravel(x)[0]) for x in np.ravel(m[k])]
+                      for k in ("InputName", "OutputName"))
+    except KeyError as exc:
+        raise InputError(f"{path} lacks the controller variable {exc}") from exc
+    n = A.shape[0] if A.size else 0
+    A = A.reshape(n, n)
+    B, C = B.reshape(n, D.shape[1]), C.reshape(D.shape[0], n)
+    ts = float(np.ravel(m["Ts"])[0]) if "Ts" in m else 0
+    K = control.ss(A, B, C, D, ts, inputs=names[0], outputs=names[1], name="K")
+    return K, names
+
+
+def _json_default(obj):
+    if isinstance(obj, np.generic):
+        return obj.item()
+    if isinstance(obj, np.ndarray):
+        return obj.tolist()
+    return str(obj)

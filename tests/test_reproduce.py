@@ -98,7 +98,7 @@ def run(tmp_path_factory):
 @pytest.mark.slow
 def test_every_file_is_written(run):
     names = {p.name for p in run.out.iterdir()}
-    assert EXPECTED_PNGS | {"summary.json", "controller.json"} <= names
+    assert EXPECTED_PNGS | {"summary.json", "controller.json", "controller.mat"} <= names
     assert {p.name for p in run.summary.files} == names
 
 
@@ -195,6 +195,24 @@ def test_progress_reports_each_stage_and_iteration(run):
     for word in ("µ design", "limit", "Monte-Carlo", "ISO 8608", "figures"):
         assert word in text
     assert isinstance(run.calls[0], np.random.Generator)
+
+
+@pytest.mark.slow
+def test_stage_messages_match_the_stages_the_cli_bar_counts(run, capsys):
+    """One unindented message per stage of R.STAGES (the CLI's bar total), in order."""
+    from lmi_suspension.cli import _StageBar
+
+    heads = [m for m in run.messages if not m.startswith(" ") and not m.startswith("done in")]
+    assert len(heads) == len(R.STAGES)
+    assert set(json.loads((run.out / "summary.json").read_text())["timings"]) == \
+        set(R.STAGES) | {"total"}
+    bar = _StageBar(R.STAGES)
+    for m in run.messages[:-1]:
+        bar(m)
+    assert bar._bar.n == len(R.STAGES) - 1  # the last stage is running
+    bar.close()
+    assert bar._bar.n == len(R.STAGES)
+    assert "stages" in capsys.readouterr().err
 
 
 @pytest.mark.slow

@@ -38,6 +38,11 @@ logger = logging.getLogger(__name__)
 
 #: Names of the compared controllers, in table order.
 CONTROLLER_NAMES = ("passive", "hinf_lmi_nominal", "hinf_riccati", "mu")
+#: the stages of :func:`reproduce`, in order: each announces itself with one progress
+#: message that does not start with a space (details follow indented), and its wall time
+#: is ``summary.json``'s ``timings[name]``
+STAGES = ("mu_design", "mu_analysis", "hinf_lmi_nominal", "hinf_riccati", "limit",
+          *(f"simulate_{n}" for n in CONTROLLER_NAMES), "iso_C", "monte_carlo", "figures")
 _LONG_NAMES = {"passive": "passive", "hinf_lmi_nominal": "H∞ LMI (no delay)",
                "hinf_riccati": "H∞ Riccati", "mu": "µ (D-K)"}
 
@@ -301,7 +306,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         are recorded in ``summary.json`` instead).
     """
     from .. import __version__
-    from ..io import save_controller
+    from ..io import save_controller, save_controller_mat
     from ..seat import (
         SeatParameters,
         bump,
@@ -481,6 +486,9 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     }
     files.append(save_controller(out / "controller.json", mu_design.K, inputs=["x1", "x3"],
                                  outputs=["u"], metadata=metadata))
+    # the same controller for MATLAB / Simulink (lmi-suspension export does it for any file)
+    files.append(save_controller_mat(out / "controller.mat", mu_design.K, inputs=["x1", "x3"],
+                                     outputs=["u"], metadata=metadata))
     tok = stage("monte_carlo", f"Monte-Carlo over the uncertainty set ({cfg.mc_n} samples, "
                 f"µ controller, {cfg.mc_workers or 'no'} Dask workers) ...")
     mc_data = _monte_carlo(out / "controller.json", cfg, (delays[0], delays[-1]), params,
