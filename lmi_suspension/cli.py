@@ -348,6 +348,12 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     logging.basicConfig(level=logging.INFO if args.verbose else logging.WARNING,
                         format="%(levelname)s %(name)s: %(message)s")
+    if not args.verbose:
+        # dask sets its loggers to INFO when it is imported (after this); their start and
+        # close chatter would reach the handler above and break the progress bars
+        for handler in logging.getLogger().handlers:
+            handler.addFilter(lambda r: not r.name.startswith("distributed")
+                              or r.levelno >= logging.ERROR)
     try:
         return args.func(args)
     except (LmiSuspensionError, ValueError, OSError) as exc:
