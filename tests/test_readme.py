@@ -28,8 +28,19 @@ def test_ci_runs_quickstart_line_two():
                 and not c.startswith(("set ", "cd ", "export ", "echo ", "other="))]
     assert commands[0] == quickstart_lines()[1]
     # then the numerical tests once more under another OpenBLAS kernel
-    assert len(commands) == 2 and commands[1].startswith("OPENBLAS_CORETYPE=$other ")
+    assert len(commands) == 3 and commands[1].startswith("OPENBLAS_CORETYPE=$other ")
     assert "tests/test_hinfsyn.py" in commands[1] and "tests/test_musyn.py" in commands[1]
+    # then the documentation, built by the README's command, warnings as errors
+    assert commands[2] == docs_command() and " -W " in commands[2]
+
+
+def docs_command() -> str:
+    text = (ROOT / "README.md").read_text()
+    section = text.split("## Documentation", 1)[1]
+    block = section.split("```bash", 1)[1].split("```", 1)[0]
+    lines = [ln for ln in block.splitlines() if ln.strip()]
+    assert len(lines) == 1
+    return lines[0]
 
 
 @pytest.mark.slow  # the snippet runs a D-K iteration (≈ 40 s)

@@ -113,14 +113,14 @@ def plot_peak_vs_delay(delays: Sequence[float], peaks: Mapping[str, Sequence[flo
                        limit: float | None = None, passive: float | None = None,
                        stable: Mapping[str, Sequence[bool]] | None = None,
                        title: str = "") -> Figure:
-    """Peak |z̈3| on the bump against the actuator delay, with the physical limit.
+    """Peak ``|z̈3|`` on the bump against the actuator delay, with the physical limit.
 
     Parameters
     ----------
     delays : sequence of float
         Delays in seconds.
     peaks : mapping of label -> sequence of float
-        Peak |z̈3| of each controller at each delay (``nan`` where unstable).
+        Peak ``|z̈3|`` of each controller at each delay (``nan`` where unstable).
     limit : float, optional
         The smallest peak any admissible force history reaches (the LP bound).
     passive : float, optional
