@@ -19,6 +19,8 @@ from lmi_suspension.errors import (AssumptionError, DimensionError, DiscreteTime
                                    SolverError)
 from lmi_suspension.lti import GeneralizedPlant, hinfnorm, lft
 from lmi_suspension.synthesis import HinfsynOptions, HinfsynResult, hinfsyn
+from lmi_suspension.synthesis import lmi as _lmi
+from lmi_suspension.synthesis.hinfsyn import _hinfsyn
 from lmi_suspension.synthesis.examples import random_plant
 from lmi_suspension.synthesis.lmi import balancing_transform
 
@@ -402,15 +404,19 @@ def test_bad_input_raises_typed_errors():
         hinfsyn(P, 1, 1, method="magic")
     with pytest.raises(ParameterError):
         HinfsynOptions(gamma=-1.0)
-    with pytest.raises(ParameterError, match="max_threads"):
-        HinfsynOptions(max_threads=-1)
-    with pytest.raises(ParameterError, match="static_regularization"):
-        HinfsynOptions(static_regularization=float("nan"))
-    settings = HinfsynOptions(max_threads=2, static_regularization=1e-9).clarabel_settings()
-    assert settings["max_threads"] == 2 and settings["static_regularization_constant"] == 1e-9
+    # the solver's own knobs are private constants (issue 15): the options hold what a
+    # user reasons about, and the Clarabel settings carry them through explicitly
+    settings = _lmi.clarabel_settings(HinfsynOptions(tol_gap_rel=1e-5, max_iter=50))
+    assert settings["tol_gap_rel"] == 1e-5 and settings["max_iter"] == 50
+    assert settings["static_regularization_constant"] == _lmi._STATIC_REG
+    assert settings["max_threads"] == _lmi._MAX_THREADS
     assert settings["iterative_refinement_enable"] is False
-    assert HinfsynOptions(refine_gamma_minimisation=True).clarabel_settings()[
+    assert _lmi.clarabel_settings(HinfsynOptions(), refine=True)[
         "iterative_refinement_enable"] is True
+    for gone in ("max_threads", "static_regularization", "riccati_probes", "riccati_bracket",
+                 "direct_solve_method", "refine_gamma_minimisation"):
+        with pytest.raises(TypeError):
+            HinfsynOptions(**{gone: None})
 
 
 def test_unstabilisable_and_undetectable_modes_are_named():
@@ -444,7 +450,7 @@ def test_riccati_assumptions_are_checked():
 
 @pytest.mark.slow  # python-control's Riccati synthesis takes ~30 s on this plant
 @pytest.mark.parametrize("static_regularization", [1e-10, 1e-8])
-def test_nominal_seat_plant_against_riccati(static_regularization):
+def test_nominal_seat_plant_against_riccati(static_regularization, monkeypatch):
     """A nominal seat plant (paper's Fig. 2 without the delay and uncertainty channels)
     with the comfort weights of the 2026-11-22 design.  With Clarabel's static
     regularisation at 1e-8 the γ minimisation in the plant's own coordinates used to stop
@@ -456,8 +462,8 @@ def test_nominal_seat_plant_against_riccati(static_regularization):
     P = _nominal_seat_plant()
     ric = hinfsyn(P, P.ny, P.nu, method="riccati", options=HinfsynOptions(riccati_scale=True))
     reference = hinfnorm(lft(P, ric.K))[0]
-    lmi = hinfsyn(P, P.ny, P.nu, options=HinfsynOptions(
-        static_regularization=static_regularization))
+    monkeypatch.setattr(_lmi, "_STATIC_REG", static_regularization)
+    lmi = hinfsyn(P, P.ny, P.nu)
     assert_certified(lmi, P)
     assert reference * (1 - 1e-6) <= lmi.gamma <= reference * 1.005
     assert lmi.gamma_lower <= lmi.gamma <= lmi.gamma_lower * (1 + 1e-3)
@@ -472,8 +478,7 @@ def test_riccati_probes_recover_a_destabilising_python_control_controller():
     P = random_plant(4, 2, 1, 2, 1, rng=np.random.default_rng(104))
     plain = hinfsyn(P, 1, 1, method="riccati")
     assert plain.gamma == np.inf  # the defect of the baseline, measured by hinfnorm
-    probed = hinfsyn(P, 1, 1, method="riccati",
-                     options=HinfsynOptions(riccati_probes=(1e-3, 1e-2, 0.1)))
+    probed = _hinfsyn(P, 1, 1, method="riccati", probes=(1e-3, 1e-2, 0.1))
     assert_certified(probed, P)
     assert probed.gamma <= probed.gamma_solver * 1.001 * (1 + 1e-6)
     assert any("riccati probe" in w for w in probed.warnings)
@@ -518,9 +523,8 @@ def test_riccati_bracket_starts_the_search_and_is_widened_where_wrong():
     ex = skogestad_distillation()
 
     def search(bracket):
-        res = hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati",
-                      options=HinfsynOptions(riccati_search="bisection",
-                                             riccati_bracket=bracket))
+        res = _hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati",
+                       options=HinfsynOptions(riccati_search="bisection"), bracket=bracket)
         assert_certified(res, ex.P)
         note = next(w for w in res.warnings if w.startswith("riccati bisection"))
         return res.gamma, int(note.split()[2])  # "riccati bisection: N levels, ..."
@@ -532,8 +536,8 @@ def test_riccati_bracket_starts_the_search_and_is_widened_where_wrong():
         assert search(bracket)[0] == pytest.approx(g0, rel=2e-3)
     assert g1 == pytest.approx(g0, rel=2e-3)
     for bad in ((1.0,), (2.0, 1.0), (0.0, 1.0), (1.0, float("inf"))):
-        with pytest.raises(ParameterError, match="riccati_bracket"):
-            HinfsynOptions(riccati_bracket=bad)
+        with pytest.raises(ParameterError, match="bracket"):
+            _hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati", bracket=bad)
 
 
 def test_riccati_at_a_fixed_gamma():
@@ -578,7 +582,7 @@ def _distillation_with_dscale(a):
     PD = scaled_plant(ex.P, ex.nmeas, ex.ncon, fit, [(1, 1), (1, 1), (2, 2)])
     options = HinfsynOptions(riccati_search="bisection")
     found = [hinfsyn(PD, ex.nmeas, ex.ncon, method="riccati", options=options),
-             _riccati_balanced(hinfsyn, PD, ex.nmeas, ex.ncon, options)]
+             _riccati_balanced(_hinfsyn, PD, ex.nmeas, ex.ncon, options)]
     ric = min((r for r in found if r is not None), key=lambda r: r.gamma)
     assert_certified(ric, PD)
     return PD, ex.nmeas, ex.ncon, ric

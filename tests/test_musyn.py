@@ -13,6 +13,7 @@ from lmi_suspension.lti.norms import freqresp
 from mp_reference import freqresp_mp
 from lmi_suspension.mu import MusynOptions, mussv, musyn
 from lmi_suspension.synthesis import hinfsyn
+from lmi_suspension.synthesis.hinfsyn import _hinfsyn
 
 
 @pytest.fixture(scope="module")
@@ -263,11 +264,11 @@ def test_kstep_on_a_balanced_realization_is_certified_on_the_plant(monkeypatch):
     ex = skogestad_distillation()
     calls = []
 
-    def fake_hinfsyn(P, nmeas, ncon, *, method, options):
+    def fake_hinfsyn(P, nmeas, ncon, *, method, options, **heuristics):
         calls.append((method, P.nstates, options.riccati_scale))
         if len(calls) <= 2:
             raise InfeasibleError("forced")
-        return hinfsyn(P, nmeas, ncon, method=method, options=options)
+        return _hinfsyn(P, nmeas, ncon, method=method, options=options, **heuristics)
 
     syn = dk._k_step(fake_hinfsyn, ex.P, ex.nmeas, ex.ncon, MusynOptions(method="best"),
                      gamma_prev=1.5)
@@ -315,8 +316,8 @@ def test_kstep_with_the_published_optimal_dscales_reaches_the_book_optimum():
     PD = scaled_plant(ex.P, ex.nmeas, ex.ncon, fit, [(1, 1), (1, 1), (2, 2)])
     calls = []
 
-    def recording_hinfsyn(P, nmeas, ncon, *, method, options):
-        res = hinfsyn(P, nmeas, ncon, method=method, options=options)
+    def recording_hinfsyn(P, nmeas, ncon, *, method, options, **heuristics):
+        res = _hinfsyn(P, nmeas, ncon, method=method, options=options, **heuristics)
         calls.append((method, P is PD, res.gamma))
         return res
 
@@ -379,7 +380,7 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
 
     def kstep(PD):
         calls.append(PD.nstates)
-        return _riccati_balanced(hinfsyn, PD, ex.nmeas, ex.ncon, bisection).K
+        return _riccati_balanced(_hinfsyn, PD, ex.nmeas, ex.ncon, bisection).K
 
     found = search_dscales(ex.P, ex.nmeas, ex.ncon, [(1, 1), (1, 1), (2, 2)], w,
                            mu1.d_blocks, 0.2 + mu1.upper / mu1.upper.max(), 4, kstep,

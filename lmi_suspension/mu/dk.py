@@ -39,7 +39,7 @@ logger = logging.getLogger(__name__)
 __all__ = ["MusynOptions", "MusynIteration", "MusynResult", "musyn", "default_omega"]
 
 #: Suboptimal levels ``(1 + r) γ`` that the Riccati K-step also tries when its γ-optimal
-#: controller certifies above its own γ (see ``HinfsynOptions.riccati_probes``).
+#: controller certifies above its own γ (the formulas are ill-conditioned at the optimum).
 KSTEP_RICCATI_PROBES = (1e-3, 3e-3, 1e-2, 3e-2, 0.1)
 #: relative slack before a K-step counts as worse than keeping the previous controller
 _KSTEP_RTOL = 1e-3
@@ -76,7 +76,8 @@ class MusynOptions:
         certified closed-loop γ.
     hinfsyn_options : HinfsynOptions or None
         Options passed to every K-step (default: ``HinfsynOptions`` with
-        ``riccati_probes = KSTEP_RICCATI_PROBES`` and ``riccati_search = "bisection"``).
+        ``riccati_search = "bisection"``; the Riccati K-steps also try the suboptimal
+        levels ``KSTEP_RICCATI_PROBES``).
     max_dfit_order : int
         Largest order of each D-scale fit.
     dfit_rtol : float
@@ -448,7 +449,8 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     InfeasibleError
         If the first K-step finds no stabilising controller.
     """
-    from ..synthesis import hinfsyn
+    # hinfsyn with the Riccati search heuristics of the K-steps (probes, brackets)
+    from ..synthesis.hinfsyn import _hinfsyn as hinfsyn
     from .dfit import fit_dscales, scaled_plant
 
     t_start = time.perf_counter()
@@ -636,8 +638,7 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
     # the bisection search (its bracket follows the search) at free γ, whatever the
     # loop's K-steps were given
     options = replace(opts.hinfsyn_options if opts.hinfsyn_options is not None
-                      else HinfsynOptions(), riccati_search="bisection", gamma=None,
-                      riccati_probes=())
+                      else HinfsynOptions(), riccati_search="bisection", gamma=None)
 
     last = None  # the last point's γ level: neighbouring points have similar ones
 
@@ -645,11 +646,11 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
         nonlocal last
         # Riccati on a Gramian-balanced realization: the variant that finds the optimum
         # on these plants (tests: the book's optimal scalings) at ~0.1 s per point
-        here = options if last is None else replace(
-            options, riccati_bracket=(0.97 * last, 1.03 * last))
-        found = _riccati_balanced(hinfsyn, PD, nmeas, ncon, here)
+        bracket = None if last is None else (0.97 * last, 1.03 * last)
+        found = _riccati_balanced(hinfsyn, PD, nmeas, ncon, options, bracket=bracket)
         if found is None:
-            found = hinfsyn(PD, nmeas, ncon, method="riccati", options=here)
+            found = hinfsyn(PD, nmeas, ncon, method="riccati", options=options,
+                            bracket=bracket)
         last = found.gamma_solver
         return found.K
 
@@ -708,7 +709,8 @@ def _gramian_balanced(PD: control.StateSpace) -> control.StateSpace | None:
 _BALANCED_LEVELS = (0.0, 3e-4, 1e-3, 3e-3)
 
 
-def _riccati_balanced(hinfsyn, PD, nmeas: int, ncon: int, options):
+def _riccati_balanced(hinfsyn, PD, nmeas: int, ncon: int, options, *, probes: tuple = (),
+                      bracket: tuple | None = None):
     """Riccati on a Gramian-balanced realization of ``PD``, judged on ``PD`` itself.
 
     Returns the balanced realization's :class:`HinfsynResult` with the controller kept,
@@ -726,13 +728,14 @@ def _riccati_balanced(hinfsyn, PD, nmeas: int, ncon: int, options):
     plant = _gramian_balanced(PD)
     if plant is None:
         return None
-    res = hinfsyn(plant, nmeas, ncon, method="riccati", options=options)
+    res = hinfsyn(plant, nmeas, ncon, method="riccati", options=options, probes=probes,
+                  bracket=bracket)
     candidates = [res.K]
     if options.gamma is None:
         for r in _BALANCED_LEVELS:
             try:
                 candidates.append(hinfsyn(plant, nmeas, ncon, method="riccati", options=replace(
-                    options, gamma=res.gamma_solver * (1.0 + r), riccati_probes=())).K)
+                    options, gamma=res.gamma_solver * (1.0 + r))).K)
             except LmiSuspensionError:
                 continue
     loops = [(lft(PD, K, nmeas, ncon), K) for K in candidates]
@@ -759,10 +762,10 @@ def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
     from ..synthesis import HinfsynOptions
 
     base = (opts.hinfsyn_options if opts.hinfsyn_options is not None
-            else HinfsynOptions(riccati_probes=KSTEP_RICCATI_PROBES,
-                                riccati_search="bisection"))
+            else HinfsynOptions(riccati_search="bisection"))
+    probes = KSTEP_RICCATI_PROBES  # used by the Riccati route only
     if opts.method != "best":
-        return hinfsyn(PD, nmeas, ncon, method=opts.method, options=base)
+        return hinfsyn(PD, nmeas, ncon, method=opts.method, options=base, probes=probes)
     results, errors = [], []
 
     def previous_beaten() -> bool:
@@ -775,7 +778,7 @@ def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
             if previous_beaten():
                 continue  # only where the other two did not beat the previous controller
             try:
-                found = _riccati_balanced(hinfsyn, PD, nmeas, ncon, options)
+                found = _riccati_balanced(hinfsyn, PD, nmeas, ncon, options, probes=probes)
             except LmiSuspensionError as exc:
                 errors.append(exc)
                 continue
@@ -795,7 +798,7 @@ def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
             # an LMI optimum far above a certified Riccati γ is a failed solve: stop early
             options = replace(base, gamma_abort=2.0 * min(r.gamma for r in results))
         try:
-            res = hinfsyn(PD, nmeas, ncon, method=method, options=options)
+            res = hinfsyn(PD, nmeas, ncon, method=method, options=options, probes=probes)
         except LmiSuspensionError as exc:
             errors.append(exc)
             continue

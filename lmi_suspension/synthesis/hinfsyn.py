@@ -157,6 +157,18 @@ def hinfsyn(P, nmeas: int, ncon: int, *, method: str = "lmi",
     >>> bool(info.stable), bool(gamma <= 1.005 * info.gamma_lower)
     (True, True)
     """
+    return _hinfsyn(P, nmeas, ncon, method, options)
+
+
+def _hinfsyn(P, nmeas: int, ncon: int, method: str = "lmi",
+             options: HinfsynOptions | None = None, *, probes: tuple = (),
+             bracket: tuple | None = None) -> HinfsynResult:
+    """:func:`hinfsyn` with the Riccati route's search heuristics that ``musyn`` uses:
+    ``probes``, relative levels ``(1 + r) γ`` whose suboptimal controllers are also
+    certified when the γ-optimal one certifies above its own γ (the formulas are
+    ill-conditioned at the optimum), and ``bracket``, the ``(lo, hi)`` levels the
+    ``"bisection"`` search starts from (checked and widened by factors of 4 where
+    wrong)."""
     opts = HinfsynOptions() if options is None else options
     if not isinstance(opts, HinfsynOptions):
         raise ParameterError("options must be a HinfsynOptions instance")
@@ -167,8 +179,17 @@ def hinfsyn(P, nmeas: int, ncon: int, *, method: str = "lmi",
     # PBH tests on the balanced plant: the rank tolerance is relative to the matrix
     # norm, which balancing keeps from being dominated by a few huge entries
     check_stabilizable(scale_plant(G)[0])
+    if bracket is not None:
+        try:
+            lo, hi = (float(x) for x in bracket)
+        except (TypeError, ValueError) as exc:
+            raise ParameterError("bracket must be a pair (lo, hi)") from exc
+        if not (np.isfinite(hi) and 0 < lo < hi):
+            raise ParameterError(f"bracket needs 0 < lo < hi, got {bracket!r}")
+    if not all(np.isfinite(r) and r > 0 for r in probes):
+        raise ParameterError(f"probes must be positive relative steps, got {probes!r}")
     if method == "riccati":
-        return _hinfsyn_riccati(G, opts, t0)
+        return _hinfsyn_riccati(G, opts, t0, tuple(probes), bracket)
     return _hinfsyn_lmi(G, opts, t0)
 
 
@@ -199,7 +220,8 @@ def _sb10ad(Gs: GeneralizedPlant, gamma: float | None):
         raise
 
 
-def _hinfsyn_riccati(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> HinfsynResult:
+def _hinfsyn_riccati(G: GeneralizedPlant, opts: HinfsynOptions, t0: float,
+                     probes: tuple = (), bracket: tuple | None = None) -> HinfsynResult:
     check_riccati_assumptions(G)
     warnings: list[str] = []
     t1 = time.perf_counter()
@@ -213,7 +235,7 @@ def _hinfsyn_riccati(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hi
         return (sc.controller_to_original(Ks) if sc is not None else Ks), gam / factor
 
     if opts.gamma is None and opts.riccati_search == "bisection":
-        K, gam = _bisect_riccati(G, synthesise, opts, warnings)
+        K, gam = _bisect_riccati(G, synthesise, opts, warnings, bracket)
     else:
         K, gam = synthesise(opts.gamma)
     t2 = time.perf_counter()
@@ -221,10 +243,10 @@ def _hinfsyn_riccati(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hi
     if np.isfinite(gamma) and gamma > gam * 1.01:
         warnings.append(f"riccati: controller is {100 * (gamma / gam - 1):.3g} % above "
                         "its own gamma")
-    if opts.gamma is None and opts.riccati_probes and not gamma <= gam * (1 + opts.cert_rtol):
+    if opts.gamma is None and probes and not gamma <= gam * (1 + opts.cert_rtol):
         # At the optimum the controller formulas are ill-conditioned; suboptimal levels
         # give other, often far better, controllers (certified like the first).
-        for r in opts.riccati_probes:
+        for r in probes:
             try:
                 Kr, _ = synthesise(gam * (1.0 + r))
             except (InfeasibleError, SolverError) as exc:
@@ -244,7 +266,8 @@ def _hinfsyn_riccati(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hi
                          warnings=tuple(warnings), controller_fastest_pole=_fastest_pole(K))
 
 
-def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warnings: list):
+def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warnings: list,
+                    bracket: tuple | None = None):
     """γ search over SLICOT's suboptimal controllers (``sb10ad`` job 4), every level judged
     by its certified closed loop.
 
@@ -273,7 +296,7 @@ def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warni
             best = (gamma, K)
         return True
 
-    lo, hi = (0.0, 1.0) if opts.riccati_bracket is None else map(float, opts.riccati_bracket)
+    lo, hi = (0.0, 1.0) if bracket is None else map(float, bracket)
     lo_unachieved = False
     for _ in range(_RICCATI_BRACKET_STEPS):
         if achieved(hi):

@@ -71,6 +71,19 @@ _CONTROLLER_STATIC_REG = 1e-8
 #: sigma up to 1.3e7, data from 1e-12 to 4e4) failed at 1e-8 and 1e-7 and was solved at
 #: 1e-6 (measured 2026-11-25)
 _RECOVERY_STATIC_REG = 1e-7
+#: Clarabel's KKT factorisation: the supernodal, multithreaded "faer" was about twice as
+#: fast as "qdldl" on the dense KKT systems of these SDPs (measured 2026-11-24)
+_DIRECT_SOLVE_METHOD = "faer"
+#: threads of that factorisation: one was the fastest on the project's 2-core machines
+#: (γ minimisation of the 22-state benchmark plant: 1.18 s on one thread, 1.25 s on two,
+#: 1.23 s automatic; measured 2026-11-24, BENCHMARKS.md)
+_MAX_THREADS = 1
+#: Clarabel's static regularisation in the γ minimisation (its own default is 1e-8).  These
+#: SDPs are nearly degenerate near the optimal γ and the regularisation decides how close
+#: the solver gets: with 1e-8 the controller LMI of COMPleib AC6 stopped at a common slack
+#: 0.0112 where 0.0128 is feasible (certified γ 0.27 % above the LMI optimum instead of
+#: 0.06 %, measured 2026-11-24); recoveries raise it (_RECOVERY_STATIC_REG)
+_STATIC_REG = 1e-10
 #: how the warning of an active trace bound in the γ minimisation begins
 TRACE_BOUND_ACTIVE = "the bound trace(X) + trace(Y)"
 
@@ -249,8 +262,28 @@ def _projections(P_r: GeneralizedPlant, P_s: GeneralizedPlant, sparse: bool = Tr
                               s["D11"].T, sparse))
 
 
-def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
-    """Solve with explicit Clarabel settings; recover from inaccurate/failed solves.
+def clarabel_settings(opts: HinfsynOptions, *, refine: bool = False,
+                      static_reg: float = _STATIC_REG) -> dict:
+    """Keyword arguments of ``problem.solve(solver=cvxpy.CLARABEL, ...)``: the tolerances
+    and iteration bound of ``opts``, and this module's solver constants.  ``refine``
+    turns on Clarabel's iterative refinement of each KKT solve: off in the γ
+    minimisation (22-state benchmark plant: 0.53 s instead of 0.86 s, 19 iterations
+    either way, optimum 0.006 % higher; measured 2026-11-24), on in the controller LMI
+    and in every recovery."""
+    return dict(tol_gap_abs=opts.tol_gap_abs, tol_gap_rel=opts.tol_gap_rel,
+                tol_feas=opts.tol_feas, max_iter=int(opts.max_iter),
+                reduced_tol_gap_abs=opts.reduced_tol_gap_abs,
+                reduced_tol_gap_rel=opts.reduced_tol_gap_rel,
+                reduced_tol_feas=opts.reduced_tol_feas,
+                direct_solve_method=_DIRECT_SOLVE_METHOD, max_threads=_MAX_THREADS,
+                iterative_refinement_enable=bool(refine),
+                static_regularization_constant=float(static_reg))
+
+
+def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list, *,
+           refine: bool = False, static_reg: float | None = None):
+    """Solve with explicit Clarabel settings (:func:`clarabel_settings`); recover from
+    inaccurate/failed solves.
 
     Returns the status and the number of recoveries it took (0: the first attempt).
 
@@ -258,7 +291,8 @@ def _solve(prob: cp.Problem, opts: HinfsynOptions, what: str, warnings: list):
     the static regularisation (1e-7, 1e-6, ...) and refines every KKT solve
     iteratively; every recovery is recorded in ``warnings``.
     """
-    settings = opts.clarabel_settings()
+    settings = clarabel_settings(opts, refine=refine,
+                                 static_reg=_STATIC_REG if static_reg is None else static_reg)
     attempts = [settings]
     for i in range(int(opts.max_recoveries)):
         kw = dict(settings)
@@ -564,11 +598,9 @@ class ControllerLmi:
         # Clarabel's default static regularisation at least: with 1e-10 its first KKT
         # factorisation failed on the relative form of COMPleib HE1, while 1e-8 and 1e-7
         # gave the same controller (measured 2026-11-25)
-        status, _ = _solve(self.problem, replace(opts, refine_gamma_minimisation=refine,
-                                              static_regularization=max(
-                                                  opts.static_regularization,
-                                                  _CONTROLLER_STATIC_REG)),
-                        f"controller LMI at gamma={gamma:.6g}", warnings)
+        status, _ = _solve(self.problem, opts, f"controller LMI at gamma={gamma:.6g}",
+                           warnings, refine=refine,
+                           static_reg=max(_STATIC_REG, _CONTROLLER_STATIC_REG))
         t = self.t.value
         if status in _INFEASIBLE or t is None or t <= 0.0:
             raise InfeasibleError(

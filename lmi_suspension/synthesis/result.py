@@ -57,13 +57,6 @@ class HinfsynOptions:
         ``method="riccati"`` only: balance the plant (as the LMI route does) before
         python-control sees it. Off by default so that the baseline is python-control
         exactly as users call it.
-    riccati_probes : tuple of float
-        ``method="riccati"`` with ``gamma=None`` only: when the Riccati controller
-        certifies more than ``cert_rtol`` above its own γ (the formulas are
-        ill-conditioned at the optimum), the suboptimal controllers at
-        ``(1 + r) γ`` for each ``r`` here are also computed and certified, and the
-        lowest certified one is returned.  Empty by default (the plain baseline);
-        :func:`~lmi_suspension.mu.musyn` turns it on for its K-steps.
     riccati_search : {"python-control", "bisection"}
         ``method="riccati"`` with ``gamma=None`` only: ``"python-control"`` (default, the
         baseline as users call it) takes python-control's γ-optimal ``hinfsyn``;
@@ -73,38 +66,11 @@ class HinfsynOptions:
         :func:`~lmi_suspension.mu.musyn`).
     riccati_rtol : float
         Relative width at which the ``"bisection"`` search stops.
-    riccati_bracket : tuple of float or None
-        ``"bisection"`` only: levels ``(lo, hi)`` to start the search from, when a γ is
-        roughly known (the D-scale search of :func:`~lmi_suspension.mu.musyn` passes
-        ±3 % around its last one); both ends are checked and widened by factors of 4
-        where wrong.  ``None``: start from γ = 1.
     gamma_abort : float or None
         ``method="lmi"`` only: raise :class:`~lmi_suspension.errors.SolverError` as soon as
         the γ minimisation's optimum exceeds this level (a γ another controller is
         certified to achieve: the minimisation has then failed, and reconstructing
         around it is wasted time).  Used by ``musyn``'s ``method="best"``.
-    direct_solve_method : str
-        Clarabel's KKT factorisation: ``"faer"`` (supernodal, multithreaded; about twice
-        as fast as ``"qdldl"`` on the dense KKT systems of these SDPs) or ``"qdldl"``.
-    max_threads : int
-        Threads of Clarabel's ``"faer"`` factorisation; 0 lets Clarabel choose.  One is
-        the default: on this project's 2-core machines it was the fastest (γ
-        minimisation of the 22-state benchmark plant: 1.18 s on one thread, 1.25 s on
-        two, 1.23 s automatic; measured 2026-11-24, recorded in BENCHMARKS.md).
-    refine_gamma_minimisation : bool
-        Clarabel's iterative refinement of each KKT solve in the γ minimisation (the
-        controller LMI always refines, and so does every recovery).  Off by default: on
-        the 22-state benchmark plant the γ minimisation took 0.53 s instead of 0.86 s
-        (19 iterations either way, optimum 0.006 % higher).  Without refinement in the
-        controller LMI too, the whole synthesis took 1.22 s instead of 1.37 s, but the
-        nominal seat plant of the tests certified 0.53 % above python-control's
-        controller instead of 0.01 % (measured 2026-11-24).
-    static_regularization : float
-        Clarabel's static KKT regularisation (its default is 1e-8).  These SDPs are
-        nearly degenerate near the optimal γ, and the regularisation decides how close
-        to it the solver gets: with 1e-8 the controller LMI of COMPleib AC6 stopped at
-        a common slack 0.0112 where 0.0128 is feasible (certified γ 0.27 % above the LMI
-        optimum instead of 0.06 %).  Recoveries raise it to 1e-7.
     """
 
     gamma: float | None = None
@@ -123,20 +89,14 @@ class HinfsynOptions:
     scale: bool = True
     cert_rtol: float = 5e-3
     riccati_scale: bool = False
-    riccati_probes: tuple = ()
     riccati_search: str = "python-control"
     riccati_rtol: float = 1e-3
-    riccati_bracket: tuple | None = None
     gamma_abort: float | None = None
-    direct_solve_method: str = "faer"
-    max_threads: int = 1
-    refine_gamma_minimisation: bool = False
-    static_regularization: float = 1e-10
 
     def __post_init__(self):
         if self.gamma is not None and not (np.isfinite(self.gamma) and self.gamma > 0):
             raise ParameterError(f"gamma must be positive and finite, got {self.gamma!r}")
-        for name in ("static_regularization", "gamma_relax", "gamma_atol",
+        for name in ("gamma_relax", "gamma_atol",
                      "tol_gap_abs", "tol_gap_rel", "tol_feas", "margin", "xy_bound",
                      "cert_rtol", "reduced_tol_gap_abs", "riccati_rtol",
                      "reduced_tol_gap_rel", "reduced_tol_feas"):
@@ -146,38 +106,10 @@ class HinfsynOptions:
         if self.riccati_search not in ("python-control", "bisection"):
             raise ParameterError("riccati_search must be 'python-control' or 'bisection', "
                                  f"got {self.riccati_search!r}")
-        if self.riccati_bracket is not None:
-            try:
-                lo, hi = (float(x) for x in self.riccati_bracket)
-            except (TypeError, ValueError) as exc:
-                raise ParameterError("riccati_bracket must be a pair (lo, hi)") from exc
-            if not (np.isfinite(hi) and 0 < lo < hi):
-                raise ParameterError(f"riccati_bracket needs 0 < lo < hi, got {self.riccati_bracket!r}")
-        if self.direct_solve_method not in ("faer", "qdldl"):
-            raise ParameterError("direct_solve_method must be 'faer' or 'qdldl', got "
-                                 f"{self.direct_solve_method!r}")
         if self.gamma_abort is not None and not self.gamma_abort > 0:
             raise ParameterError(f"gamma_abort must be positive, got {self.gamma_abort!r}")
-        if not all(np.isfinite(r) and r > 0 for r in self.riccati_probes):
-            raise ParameterError("riccati_probes must be positive relative steps, got "
-                                 f"{self.riccati_probes!r}")
-        if int(self.max_threads) < 0:
-            raise ParameterError(f"max_threads must be >= 0, got {self.max_threads!r}")
         if int(self.max_iter) < 1 or int(self.max_recoveries) < 0:
             raise ParameterError("max_iter must be >= 1 and max_recoveries >= 0")
-
-    def clarabel_settings(self) -> dict:
-        """Keyword arguments for ``problem.solve(solver=cvxpy.CLARABEL, ...)`` in the γ
-        minimisation (the controller LMI turns iterative refinement on)."""
-        return dict(tol_gap_abs=self.tol_gap_abs, tol_gap_rel=self.tol_gap_rel,
-                    tol_feas=self.tol_feas, max_iter=int(self.max_iter),
-                    reduced_tol_gap_abs=self.reduced_tol_gap_abs,
-                    reduced_tol_gap_rel=self.reduced_tol_gap_rel,
-                    reduced_tol_feas=self.reduced_tol_feas,
-                    direct_solve_method=self.direct_solve_method,
-                    max_threads=int(self.max_threads),
-                    iterative_refinement_enable=bool(self.refine_gamma_minimisation),
-                    static_regularization_constant=self.static_regularization)
 
 
 @dataclass(frozen=True)
