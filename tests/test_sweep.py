@@ -411,3 +411,10 @@ def test_a_failed_design_marks_its_cases_and_the_sweep_goes_on(tmp_path, monkeyp
     assert res.n_failed == 2
     assert all("design failed: InfeasibleError" in r["error"] for r in rows[:2])
     assert all(r["error"] is None for r in rows[2:])
+
+
+def test_progress_reports_cumulative_cases_of_this_run(tmp_path, controller_file):
+    seen = []
+    run_sweep(_spec(controller_file), tmp_path, workers=0, batch_size=5, figures=False,
+              progress=lambda done, total: seen.append((done, total)))
+    assert seen == [(5, 12), (10, 12), (12, 12)]
