@@ -1,10 +1,14 @@
-"""Controller synthesis: certified H∞ by LMIs (Clarabel) or Riccati (python-control).
+"""Controller synthesis: certified H∞ by LMIs (Clarabel) or Riccati (python-control), and
+multi-objective LMI synthesis (H∞, H2, peak bounds, pole regions; :func:`msyn`).
 
 Every method returns the same :class:`HinfsynResult`; its ``gamma`` is always the
 certified closed-loop norm ``hinfnorm(lft(P, K))``.
 """
 
+from . import constraints
 from .hinfsyn import hinfsyn
+from .multiobjective import MultiobjectiveResult, SpecificationCertificate, h2hinfsyn, msyn
 from .result import HinfsynOptions, HinfsynResult, Timings
 
-__all__ = ["hinfsyn", "HinfsynOptions", "HinfsynResult", "Timings"]
+__all__ = ["hinfsyn", "HinfsynOptions", "HinfsynResult", "Timings", "msyn", "h2hinfsyn",
+           "MultiobjectiveResult", "SpecificationCertificate", "constraints"]

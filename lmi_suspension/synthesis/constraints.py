@@ -1,0 +1,307 @@
+"""Specifications of multi-objective synthesis: one small class each, and the protocol a
+researcher implements to add one.
+
+A specification receives the synthesis variables as affine CVXPY expressions
+(:class:`LmiVariables`: the change of variables of Scherer, Gahinet and Chilali, IEEE TAC
+42(7), 1997, with one Lyapunov matrix shared by every specification) and returns its LMIs;
+and it certifies itself on the closed loop ``lft(P, K)`` alone, without the LMI variables.
+
+The protocol (:class:`Specification`)::
+
+    class MySpec:
+        name = "my spec"
+        def lmis(self, v: LmiVariables, level, slack) -> list:    # CVXPY constraints
+            ...
+        def certify(self, CL: control.StateSpace) -> float:       # achieved value
+            ...
+        bound: float | None                                       # the bound it asks for
+
+``level`` is the CVXPY expression of the bound (a constant for a constraint, the objective
+variable for the objective); ``slack`` is the margin every strict inequality keeps
+(``L <= -slack I``), which the synthesis maximises when it reconstructs the controller.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol, runtime_checkable
+
+import control
+import cvxpy as cp
+import numpy as np
+import scipy.linalg
+
+from ..errors import DimensionError, ParameterError
+from ..lti.norms import hinfnorm
+
+__all__ = ["Specification", "LmiVariables", "Channel", "HinfBound", "H2Bound", "PeakBound",
+           "HalfPlane", "Disk", "Sector"]
+
+
+def _sym(E):
+    return (E + E.T) / 2
+
+
+@dataclass(frozen=True)
+class Channel:
+    """Rows of ``z`` and columns of ``w`` (0-based, in the plant's order); ``None`` means
+    all of them."""
+
+    outputs: tuple | None = None
+    inputs: tuple | None = None
+
+    def rows(self, nz: int) -> np.ndarray:
+        return _indices(self.outputs, nz, "outputs")
+
+    def cols(self, nw: int) -> np.ndarray:
+        return _indices(self.inputs, nw, "inputs")
+
+
+def _indices(sel, n: int, what: str) -> np.ndarray:
+    if sel is None:
+        return np.arange(n)
+    idx = np.atleast_1d(np.asarray(sel, dtype=int))
+    if idx.size == 0 or idx.min() < 0 or idx.max() >= n:
+        raise DimensionError(f"channel {what} {list(idx)} out of range 0..{n - 1}")
+    return idx
+
+
+@dataclass
+class LmiVariables:
+    """The synthesis variables and the closed-loop data they make affine.
+
+    ``calA`` is ``[[A Y + B2 Ĉ, A + B2 D̂ C2], [Â, X A + B̂ C2]]``, the image of the
+    closed-loop ``A`` under the congruence that linearises it; ``calX`` is
+    ``[[Y, I], [I, X]]``; :meth:`B`, :meth:`C` and :meth:`D` give the same for a channel.
+    A closed-loop inequality ``Aclᵀ P + P Acl ...`` with the common ``P`` becomes the same
+    inequality in these expressions (Scherer et al. 1997, Sec. III).
+    """
+
+    X: cp.Variable
+    Y: cp.Variable
+    Ah: cp.Variable
+    Bh: cp.Variable
+    Ch: cp.Variable
+    Dh: cp.Variable
+    data: dict = field(repr=False)
+
+    @property
+    def n(self) -> int:
+        return self.X.shape[0]
+
+    @property
+    def calA(self):
+        d = self.data
+        return cp.bmat([[d["A"] @ self.Y + d["B2"] @ self.Ch, d["A"] + d["B2"] @ self.Dh @ d["C2"]],
+                        [self.Ah, self.X @ d["A"] + self.Bh @ d["C2"]]])
+
+    @property
+    def calX(self):
+        n = self.n
+        return _sym(cp.bmat([[self.Y, np.eye(n)], [np.eye(n), self.X]]))
+
+    def B(self, ch: Channel):
+        d = self.data
+        cols = ch.cols(d["B1"].shape[1])
+        B1, D21 = d["B1"][:, cols], d["D21"][:, cols]
+        return cp.vstack([B1 + d["B2"] @ self.Dh @ D21, self.X @ B1 + self.Bh @ D21])
+
+    def C(self, ch: Channel):
+        d = self.data
+        rows = ch.rows(d["C1"].shape[0])
+        C1, D12 = d["C1"][rows], d["D12"][rows]
+        return cp.hstack([C1 @ self.Y + D12 @ self.Ch, C1 + D12 @ self.Dh @ d["C2"]])
+
+    def D(self, ch: Channel):
+        d = self.data
+        rows, cols = ch.rows(d["C1"].shape[0]), ch.cols(d["B1"].shape[1])
+        return d["D11"][np.ix_(rows, cols)] + d["D12"][rows] @ self.Dh @ d["D21"][:, cols]
+
+
+@runtime_checkable
+class Specification(Protocol):
+    """What a specification provides (see the module docstring)."""
+
+    name: str
+
+    def lmis(self, v: LmiVariables, level, slack) -> list: ...
+
+    def certify(self, CL: control.StateSpace) -> float: ...
+
+
+def _sub(CL: control.StateSpace, ch: Channel):
+    nz, nw = CL.noutputs, CL.ninputs
+    rows, cols = ch.rows(nz), ch.cols(nw)
+    return (np.asarray(CL.A), np.asarray(CL.B)[:, cols], np.asarray(CL.C)[rows],
+            np.asarray(CL.D)[np.ix_(rows, cols)])
+
+
+def _gramian(A, B) -> np.ndarray:
+    if not np.all(np.linalg.eigvals(A).real < 0):
+        return np.full((A.shape[0], A.shape[0]), np.inf)
+    return scipy.linalg.solve_continuous_lyapunov(A, -B @ B.T)
+
+
+@dataclass(frozen=True)
+class HinfBound:
+    """``‖T_zw‖∞ < bound`` on a channel (bounded-real lemma); ``bound=None`` when it is
+    the objective."""
+
+    channel: Channel = Channel()
+    bound: float | None = None
+    name: str = "H∞"
+
+    def lmis(self, v: LmiVariables, level, slack) -> list:
+        B, C, D = v.B(self.channel), v.C(self.channel), v.D(self.channel)
+        nw, nz = B.shape[1], C.shape[0]
+        M = _sym(cp.bmat([[v.calA + v.calA.T, B, C.T],
+                          [B.T, -level * np.eye(nw), D.T],
+                          [C, D, -level * np.eye(nz)]]))
+        return [M << -slack * np.eye(M.shape[0])]
+
+    def certify(self, CL) -> float:
+        A, B, C, D = _sub(CL, self.channel)
+        return float(hinfnorm(control.ss(A, B, C, D))[0])
+
+
+def _no_feedthrough(v: LmiVariables, ch: Channel, what: str) -> list:
+    d = v.data
+    rows, cols = ch.rows(d["C1"].shape[0]), ch.cols(d["B1"].shape[1])
+    if np.any(d["D11"][np.ix_(rows, cols)]):
+        raise ParameterError(f"{what}: the channel has a direct feedthrough D11 != 0; its "
+                             "H2 / peak norm is infinite")
+    Dcl = v.D(ch)
+    return [Dcl == 0] if np.any(d["D12"][rows]) and np.any(d["D21"][:, cols]) else []
+
+
+@dataclass(frozen=True)
+class H2Bound:
+    """``‖T_zw‖₂ < bound`` on a channel (needs a strictly proper closed loop there)."""
+
+    channel: Channel = Channel()
+    bound: float | None = None
+    name: str = "H2"
+
+    def lmis(self, v: LmiVariables, level, slack) -> list:
+        B, C = v.B(self.channel), v.C(self.channel)
+        nw, nz = B.shape[1], C.shape[0]
+        Q = cp.Variable((nz, nz), symmetric=True)
+        M1 = _sym(cp.bmat([[v.calA + v.calA.T, B], [B.T, -np.eye(nw)]]))
+        M2 = _sym(cp.bmat([[v.calX, C.T], [C, Q]]))
+        # ‖T‖₂² < ν: level is ν = bound² (squared so that the LMI stays affine)
+        return [M1 << -slack * np.eye(M1.shape[0]), M2 >> slack * np.eye(M2.shape[0]),
+                cp.trace(Q) <= level] + _no_feedthrough(v, self.channel, self.name)
+
+    def certify(self, CL) -> float:
+        A, B, C, D = _sub(CL, self.channel)
+        if np.any(D):
+            return float("inf")
+        return float(np.sqrt(max(np.trace(C @ _gramian(A, B) @ C.T), 0.0)))
+
+    squared = True  # the LMI level is the bound squared
+
+
+@dataclass(frozen=True)
+class PeakBound:
+    """Generalized H2 (energy-to-peak) bound per output row: ``|z_i(t)| <= bounds[i]`` for
+    every ``w`` with ``‖w‖₂ <= 1`` (Wilson, IEEE TAC 34(1), 1989): the peak of row ``i``
+    is ``sqrt((C Wc Cᵀ)_ii)``, ``Wc`` the closed loop's controllability Gramian.  Scale
+    ``w`` (or the bounds) for another disturbance energy."""
+
+    channel: Channel = Channel()
+    bounds: tuple = ()
+    name: str = "peak"
+
+    @property
+    def bound(self):
+        return max(self.bounds) if self.bounds else None
+
+    def lmis(self, v: LmiVariables, level, slack) -> list:
+        B, C = v.B(self.channel), v.C(self.channel)
+        nw, nz = B.shape[1], C.shape[0]
+        if len(self.bounds) != nz:
+            raise DimensionError(f"{self.name}: {len(self.bounds)} bounds for {nz} outputs")
+        if not all(b > 0 and np.isfinite(b) for b in self.bounds):
+            raise ParameterError(f"{self.name}: bounds must be positive, got {self.bounds}")
+        M1 = _sym(cp.bmat([[v.calA + v.calA.T, B], [B.T, -np.eye(nw)]]))
+        cons = [M1 << -slack * np.eye(M1.shape[0])]
+        for i, b in enumerate(self.bounds):
+            Mi = _sym(cp.bmat([[v.calX, C[i:i + 1].T], [C[i:i + 1], np.array([[b**2]])]]))
+            cons.append(Mi >> slack * np.eye(Mi.shape[0]))
+        return cons + _no_feedthrough(v, self.channel, self.name)
+
+    def certify(self, CL) -> float:
+        """The largest ratio ``peak_i / bounds[i]`` (≤ 1 when met); see :meth:`peaks`."""
+        return float(np.max(self.peaks(CL) / np.asarray(self.bounds, dtype=float)))
+
+    def peaks(self, CL) -> np.ndarray:
+        A, B, C, D = _sub(CL, self.channel)
+        if np.any(D):
+            return np.full(C.shape[0], np.inf)
+        return np.sqrt(np.maximum(np.diag(C @ _gramian(A, B) @ C.T), 0.0))
+
+
+@dataclass(frozen=True)
+class HalfPlane:
+    """Closed-loop poles with ``Re s < -alpha`` (a decay rate)."""
+
+    alpha: float = 0.0
+    name: str = "half-plane"
+    bound = None
+
+    def lmis(self, v, level, slack) -> list:
+        M = _sym(v.calA + v.calA.T + 2 * self.alpha * v.calX)
+        return [M << -slack * np.eye(M.shape[0])]
+
+    def contains(self, p: np.ndarray) -> np.ndarray:
+        return p.real < -self.alpha
+
+    def certify(self, CL) -> float:
+        """Largest ``Re p + alpha`` over the closed-loop poles (< 0 when met)."""
+        p = np.linalg.eigvals(np.asarray(CL.A))
+        return float(np.max(p.real + self.alpha)) if p.size else -np.inf
+
+
+@dataclass(frozen=True)
+class Disk:
+    """Closed-loop poles in the disk ``|s + center| < radius`` (``center >= radius``
+    keeps it in the left half-plane: bounds the natural frequencies)."""
+
+    radius: float
+    center: float = 0.0
+    name: str = "disk"
+    bound = None
+
+    def lmis(self, v, level, slack) -> list:
+        A, Xc = v.calA, v.calX
+        M = _sym(cp.bmat([[-self.radius * Xc, self.center * Xc + A],
+                          [self.center * Xc + A.T, -self.radius * Xc]]))
+        return [M << -slack * np.eye(M.shape[0])]
+
+    def certify(self, CL) -> float:
+        """Largest ``|p + center| - radius`` (< 0 when met)."""
+        p = np.linalg.eigvals(np.asarray(CL.A))
+        return float(np.max(np.abs(p + self.center) - self.radius)) if p.size else -np.inf
+
+
+@dataclass(frozen=True)
+class Sector:
+    """Closed-loop poles in the sector ``|Im s| < tan(theta) (-Re s)`` (damping ratio at
+    least ``cos(theta)``)."""
+
+    theta: float
+    name: str = "sector"
+    bound = None
+
+    def lmis(self, v, level, slack) -> list:
+        A = v.calA
+        s, c = np.sin(self.theta), np.cos(self.theta)
+        M = _sym(cp.bmat([[s * (A + A.T), c * (A - A.T)], [c * (A.T - A), s * (A + A.T)]]))
+        return [M << -slack * np.eye(M.shape[0])]
+
+    def certify(self, CL) -> float:
+        """Largest ``sin θ Re p + cos θ |Im p|`` (< 0 when met)."""
+        p = np.linalg.eigvals(np.asarray(CL.A))
+        if not p.size:
+            return -np.inf
+        return float(np.max(np.sin(self.theta) * p.real + np.cos(self.theta) * np.abs(p.imag)))

@@ -1,0 +1,400 @@
+"""Multi-objective output-feedback synthesis by LMIs (Scherer, Gahinet & Chilali 1997).
+
+One Lyapunov matrix is shared by every specification, so that H∞ and H2 norms, peak
+(generalized H2) bounds and pole regions, each on its own channel, are jointly convex in
+the change of variables ``(X, Y, Â, B̂, Ĉ, D̂)`` (:mod:`.constraints`).  The synthesis:
+
+1. minimises the objective's level subject to every specification (Clarabel through
+   CVXPY, on the balanced plant of :func:`~lmi_suspension.lti.scaling.scale_plant`);
+2. fixes the level ``(1 + level_relax)`` above that optimum and takes the point of
+   largest common margin of all the inequalities inside a trace box: at the optimum
+   ``I - XY`` is singular and the controller degenerates;
+3. recovers the controller by the exact formulas and **certifies every specification on
+   ``lft(P, K)`` alone** (closed-loop poles, ``hinfnorm``, Gramians); a specification
+   violated beyond ``cert_rtol`` is an error, never a silent result.
+
+The common Lyapunov matrix makes the result conservative for several specifications (the
+price of convexity); for one H∞ objective alone it is :func:`hinfsyn`'s LMI.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass
+
+import control
+import cvxpy as cp
+import numpy as np
+
+from ..errors import InfeasibleError, ParameterError, SolverError
+from ..lti.checks import as_statespace
+from ..lti.plant import GeneralizedPlant, lft
+from ..lti.scaling import scale_plant
+from . import lmi as _lmi
+from .checks import check_stabilizable
+from .constraints import Channel, H2Bound, HinfBound, LmiVariables, PeakBound, Specification
+from .result import HinfsynOptions
+
+__all__ = ["MultiobjectiveResult", "SpecificationCertificate", "msyn", "h2hinfsyn"]
+
+logger = logging.getLogger(__name__)
+
+#: relative level above the optimum at which the controller is reconstructed (the
+#: common-Lyapunov LMIs have no frame machinery yet; 1e-3 reconstructed every test plant)
+_LEVEL_RELAX = 1e-3
+#: weight of the inequalities' common margin against the coupling's, as in ControllerLmi
+_SLACK_WEIGHT = 0.1
+#: trace box of the reconstruction, relative to the trace of the minimisation's solution
+_TRACE_BOX = 10.0
+#: reconstruction attempts (level relaxed 4x, trace box 10x wider each time)
+_RECONSTRUCTION_STEPS = 4
+#: the certificate may exceed the LMI level by this much before the result is an error
+_CERT_RTOL = 5e-3
+
+
+@dataclass(frozen=True)
+class SpecificationCertificate:
+    """One specification of a result, certified on the closed loop alone.
+
+    Attributes
+    ----------
+    name : str
+    bound : float or None
+        What was asked (``None`` for a pole region, whose value is a signed distance).
+    lmi_level : float or None
+        The level the LMIs guaranteed (the objective's optimum for the objective).
+    achieved : float
+        The returned controller's value, computed without the LMI variables (for a peak
+        bound: the largest ratio of peak to bound; for a region: the largest signed
+        distance of a pole from it, negative inside).
+    met : bool
+    """
+
+    name: str
+    bound: float | None
+    lmi_level: float | None
+    achieved: float
+    met: bool
+
+
+@dataclass(frozen=True)
+class MultiobjectiveResult:
+    """Result of :func:`msyn`; unpacks as ``K, CL, objective, info``.
+
+    ``objective`` is the objective's certified value on ``CL`` (for an H2 objective the
+    H2 norm, not its square); ``objective_lmi`` is the LMI optimum (same units), a lower
+    bound over controllers that share one Lyapunov matrix across the specifications.
+    """
+
+    K: control.StateSpace
+    CL: control.StateSpace
+    objective: float
+    objective_lmi: float
+    certificates: tuple
+    poles: np.ndarray
+    status: str
+    seconds: float
+    warnings: tuple = ()
+
+    def __iter__(self):
+        return iter((self.K, self.CL, self.objective, self))
+
+
+def _variables(Ps: GeneralizedPlant) -> LmiVariables:
+    n, nu, ny = Ps.nstates, Ps.nu, Ps.ny
+    b = Ps.blocks()
+    return LmiVariables(X=cp.Variable((n, n), symmetric=True),
+                        Y=cp.Variable((n, n), symmetric=True),
+                        Ah=cp.Variable((n, n)), Bh=cp.Variable((n, ny)),
+                        Ch=cp.Variable((nu, n)), Dh=cp.Variable((nu, ny)), data=b)
+
+
+def _controller(v: LmiVariables) -> control.StateSpace:
+    """The controller of the change of variables (``N = I``, ``Mᵀ = I - XY``)."""
+    d = v.data
+    A, B2, C2 = d["A"], d["B2"], d["C2"]
+    X, Y = v.X.value, v.Y.value
+    X, Y = (X + X.T) / 2, (Y + Y.T) / 2
+    Ah, Bh, Ch, Dk = v.Ah.value, v.Bh.value, v.Ch.value, v.Dh.value
+    n = A.shape[0]
+    MT = np.eye(n) - X @ Y
+    Bk = Bh - X @ B2 @ Dk
+    Ck = np.linalg.solve(MT.T, (Ch - Dk @ C2 @ Y).T).T
+    inner = Ah - X @ B2 @ Ck @ MT - Bk @ C2 @ Y - X @ (A + B2 @ Dk @ C2) @ Y
+    Ak = np.linalg.solve(MT.T, inner.T).T
+    return control.ss(Ak, Bk, Ck, Dk)
+
+
+def _level_of(spec) -> str:
+    return "squared" if getattr(spec, "squared", False) else "linear"
+
+
+def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
+         options: HinfsynOptions | None = None) -> MultiobjectiveResult:
+    """Multi-objective output-feedback synthesis: minimise one specification's level
+    subject to the others.
+
+    Parameters
+    ----------
+    P : control.StateSpace or GeneralizedPlant
+        Continuous-time generalized plant (controls last inputs, measurements last
+        outputs); ``D22`` must be zero.
+    nmeas, ncon : int
+    objective : HinfBound or H2Bound
+        Its ``bound`` is ignored: its level is minimised.
+    constraints : sequence of Specification
+        :class:`~.constraints.HinfBound`, :class:`~.constraints.H2Bound`,
+        :class:`~.constraints.PeakBound`, :class:`~.constraints.HalfPlane`,
+        :class:`~.constraints.Disk`, :class:`~.constraints.Sector`, or a class of one's own
+        with the same two methods (:class:`~.constraints.Specification`).  Norm bounds
+        refer to the plant's own units.
+    options : HinfsynOptions, optional
+        Clarabel's tolerances and iteration bound, ``xy_bound``, ``max_recoveries``.
+
+    Returns
+    -------
+    MultiobjectiveResult
+
+    Raises
+    ------
+    InfeasibleError
+        No controller meets the constraints (naming them).
+    SolverError
+        Clarabel failed, or a returned controller violates a specification beyond the
+        certificate tolerance.
+
+    Examples
+    --------
+    >>> from lmi_suspension.lti import GeneralizedPlant
+    >>> from lmi_suspension.synthesis.constraints import HinfBound, HalfPlane
+    >>> P = GeneralizedPlant.from_matrices(A=[[1.0]], B1=[[1.0, 0.0]], B2=[[1.0]],
+    ...     C1=[[1.0], [0.0]], C2=[[1.0]], D12=[[0.0], [1.0]], D21=[[0.0, 1.0]])
+    >>> K, CL, gamma, info = msyn(P, 1, 1, HinfBound(), [HalfPlane(alpha=0.5)])
+    >>> all(c.met for c in info.certificates)
+    True
+    """
+    t0 = time.perf_counter()
+    opts = HinfsynOptions() if options is None else options
+    G = GeneralizedPlant.from_statespace(
+        P if isinstance(P, GeneralizedPlant) else as_statespace(P, "P"), nmeas, ncon)
+    if np.any(G.blocks()["D22"]):
+        raise ParameterError("msyn needs D22 = 0 (loop shifting is not implemented here)")
+    specs = list(constraints)
+    for s in [objective, *specs]:
+        if not isinstance(s, Specification):
+            raise ParameterError(f"{s!r} is not a specification (it needs name, lmis and "
+                                 "certify)")
+    if not isinstance(objective, (HinfBound, H2Bound)):
+        raise ParameterError("the objective must be an HinfBound or an H2Bound")
+    for s in specs:
+        if isinstance(s, (HinfBound, H2Bound)) and not (s.bound and s.bound > 0):
+            raise ParameterError(f"{s.name} constraint needs a positive bound")
+    check_stabilizable(scale_plant(G)[0])
+    if G.nstates == 0:
+        raise ParameterError("msyn needs a plant with states")
+    # the balanced plant with its inputs and outputs normalised; every norm scales by the
+    # common factor f = cw / cz, which the bounds are converted with
+    Ps, sc = scale_plant(G)
+    f = sc.gamma_factor
+    v = _variables(Ps)
+
+    def scaled_level(spec, value):
+        return (value * f) ** 2 if _level_of(spec) == "squared" else value * f
+
+    def scaled_spec(spec):
+        if isinstance(spec, PeakBound):
+            return PeakBound(spec.channel, tuple(b * f for b in spec.bounds), spec.name)
+        return spec
+
+    level = cp.Variable(nonneg=True)
+    margin = opts.margin
+    n = Ps.nstates
+
+    def build(obj_level, slack, extra_slack=False):
+        cons = list(objective.lmis(v, obj_level, slack))
+        for s in specs:
+            lv = None if s.bound is None or isinstance(s, PeakBound) else \
+                scaled_level(s, s.bound)
+            cons += scaled_spec(s).lmis(v, lv, slack)
+        cons.append(v.calX >> (slack / _SLACK_WEIGHT if extra_slack else margin) * np.eye(2 * n))
+        return cons
+
+    warnings: list[str] = []
+    cons = build(level, margin) + [cp.trace(v.X) + cp.trace(v.Y) <= opts.xy_bound * n]
+    prob = cp.Problem(cp.Minimize(level), cons)
+    status, _ = _lmi._solve(prob, opts, "multi-objective minimisation", warnings)
+    if status in _lmi._INFEASIBLE or level.value is None:
+        names = ", ".join(f"{s.name}" + (f" <= {s.bound:g}" if s.bound else "") for s in specs)
+        raise InfeasibleError(f"no controller meets the constraints ({names or 'none'}) "
+                              "with a common Lyapunov matrix")
+    opt = float(level.value)
+    trace0 = float(np.trace(v.X.value) + np.trace(v.Y.value))
+    # reconstruction: the level fixed slightly above the optimum, the margin maximised;
+    # where no strictly feasible point is found there, the level is relaxed fourfold and
+    # the trace box widened tenfold, at most _RECONSTRUCTION_STEPS times
+    t = cp.Variable()
+    for step in range(_RECONSTRUCTION_STEPS):
+        target = opt * (1 + _LEVEL_RELAX * 4.0**step) + opts.gamma_atol
+        cons = build(target, _SLACK_WEIGHT * t, extra_slack=True)
+        cons += [cp.trace(v.X) + cp.trace(v.Y) <= _TRACE_BOX * 10.0**step * max(trace0, 2 * n),
+                 t <= 1.0]
+        prob = cp.Problem(cp.Maximize(t), cons)
+        try:
+            status, _ = _lmi._solve(prob, opts, "multi-objective reconstruction", warnings,
+                                    refine=True)
+        except SolverError as exc:
+            warnings.append(f"reconstruction at {target:.6g} (scaled) failed: {exc}")
+            continue
+        if status not in _lmi._INFEASIBLE and t.value is not None and t.value > 0:
+            break
+        warnings.append(f"reconstruction at {target:.6g} (scaled): no strictly feasible "
+                        "point; relaxing")
+    else:
+        raise SolverError(f"multi-objective reconstruction found no strictly feasible point "
+                          f"up to {target:.6g} (scaled; optimum {opt:.6g})")
+    _zero_feedthrough(v, [objective, *specs])
+    Ks = _controller(v)
+    K = sc.controller_to_original(Ks)
+    CL = lft(G, K)
+    poles = np.linalg.eigvals(np.asarray(CL.A))
+    if not np.all(poles.real < 0):
+        raise SolverError(f"multi-objective synthesis returned a controller that does not "
+                          f"stabilise the plant (max Re pole {np.max(poles.real):.3g})")
+    unscale = (lambda x: np.sqrt(x) / f) if _level_of(objective) == "squared" else \
+        (lambda x: x / f)
+    certs = [_certify(objective, CL, None, unscale(target))]
+    for s in specs:
+        certs.append(_certify(s, CL, s.bound, s.bound))
+    bad = [c for c in certs if not c.met]
+    if bad:
+        raise SolverError("the returned controller violates " + "; ".join(
+            f"{c.name} (achieved {c.achieved:.6g}, bound {c.bound if c.bound is not None else c.lmi_level:.6g})"
+            for c in bad))
+    return MultiobjectiveResult(K=K, CL=CL, objective=certs[0].achieved,
+                                objective_lmi=unscale(opt), certificates=tuple(certs),
+                                poles=poles, status=str(status),
+                                seconds=time.perf_counter() - t0, warnings=tuple(warnings))
+
+
+def _zero_feedthrough(v: LmiVariables, specs) -> None:
+    """Project ``D̂`` onto ``{D̂ : D12_j D̂ D21_j = 0}`` for every H2 and peak channel: the
+    LMIs hold that equality only to the solver's tolerance, and any closed-loop
+    feedthrough, however small, makes those norms infinite.  The inequalities have a
+    margin, so the projection (of the order of the tolerance) keeps them."""
+    d = v.data
+    maps = []
+    for s in specs:
+        if isinstance(s, (H2Bound, PeakBound)):
+            rows, cols = s.channel.rows(d["C1"].shape[0]), s.channel.cols(d["B1"].shape[1])
+            # vec(D12 D̂ D21) = (D21ᵀ ⊗ D12) vec(D̂)  (column-major vec)
+            maps.append(np.kron(d["D21"][:, cols].T, d["D12"][rows]))
+    if not maps:
+        return
+    import scipy.linalg
+
+    N = scipy.linalg.null_space(np.vstack(maps))  # exactly empty when D̂ must be 0
+    Dh = np.asarray(v.Dh.value)
+    vec = N @ (N.T @ Dh.reshape(-1, order="F")) if N.size else np.zeros(Dh.size)
+    v.Dh.value = vec.reshape(Dh.shape, order="F")
+
+
+def _certify(spec, CL, bound, level) -> SpecificationCertificate:
+    achieved = float(spec.certify(CL))
+    if isinstance(spec, PeakBound):
+        met = achieved <= 1 + _CERT_RTOL  # a ratio to the bounds
+    elif getattr(spec, "bound", None) is None and not isinstance(spec, (HinfBound, H2Bound)):
+        met = achieved < 0  # a region: signed distance
+    else:
+        met = achieved <= level * (1 + _CERT_RTOL)
+    return SpecificationCertificate(spec.name, bound, level, achieved, bool(met))
+
+
+def h2hinfsyn(P, nmeas: int, ncon: int, nz2: int, W=(1.0, 0.0), *, regions=(),
+              options: HinfsynOptions | None = None):
+    """Mixed H2/H∞ synthesis with MATLAB's conventions.
+
+    The last ``nz2`` performance outputs (just above the measurements) form the H2
+    channel, the others the H∞ channel, both driven by all of ``w``.  ``W = (w_inf,
+    w_2)`` weighs the objective ``w_inf ‖T∞‖∞² + w_2 ‖T2‖₂²`` (squared norms, so that the
+    combination stays convex in the LMI levels).  ``regions``: pole regions of the
+    closed loop (:class:`~.constraints.HalfPlane`, :class:`~.constraints.Disk`,
+    :class:`~.constraints.Sector`).
+
+    Returns
+    -------
+    K, CL : control.StateSpace
+    normz : tuple of float
+        ``(‖T∞‖∞, ‖T2‖₂)`` certified on ``CL``.
+    info : MultiobjectiveResult
+        Of the last solve (its ``certificates`` hold both norms and the regions).
+    """
+    G = GeneralizedPlant.from_statespace(
+        P if isinstance(P, GeneralizedPlant) else as_statespace(P, "P"), nmeas, ncon)
+    nz = G.nz
+    if not (isinstance(nz2, (int, np.integer)) and 0 < nz2 < nz):
+        raise ParameterError(f"nz2 must be between 1 and {nz - 1} (the H∞ channel needs "
+                             f"outputs too), got {nz2!r}")
+    w_inf, w_2 = (float(x) for x in W)
+    if min(w_inf, w_2) < 0 or w_inf + w_2 <= 0:
+        raise ParameterError(f"W must be two non-negative weights, not both zero, got {W!r}")
+    inf_ch = Channel(outputs=tuple(range(nz - nz2)))
+    h2_ch = Channel(outputs=tuple(range(nz - nz2, nz)))
+    if w_2 == 0:
+        res = msyn(G, nmeas, ncon, HinfBound(inf_ch), list(regions), options=options)
+    elif w_inf == 0:
+        res = msyn(G, nmeas, ncon, H2Bound(h2_ch), list(regions), options=options)
+    else:
+        res = _weighted(G, nmeas, ncon, inf_ch, h2_ch, w_inf, w_2, regions, options)
+    CL = res.CL
+    normz = (float(HinfBound(inf_ch).certify(CL)), float(H2Bound(h2_ch).certify(CL)))
+    return res.K, CL, normz, res
+
+
+def _weighted(G, nmeas, ncon, inf_ch, h2_ch, w_inf, w_2, regions, options):
+    """``min w_inf γ² + w_2 ν²`` as a scalar sweep: the Pareto point of that weighting is
+    the minimiser over the H∞ bound γ of ``w_inf γ² + w_2 ν*(γ)²``, ``ν*`` the H2 optimum
+    under ``‖T∞‖∞ <= γ`` (convex in γ), found by a bounded golden-section search."""
+    hinf = msyn(G, nmeas, ncon, HinfBound(inf_ch), list(regions), options=options)
+    lo = hinf.objective_lmi * (1 + 2 * _LEVEL_RELAX)
+    free = msyn(G, nmeas, ncon, H2Bound(h2_ch), list(regions), options=options)
+    hi = max(float(HinfBound(inf_ch).certify(free.CL)), lo * 1.01)
+
+    def cost(gamma):
+        try:
+            r = msyn(G, nmeas, ncon, H2Bound(h2_ch), [HinfBound(inf_ch, gamma), *regions],
+                     options=options)
+        except (InfeasibleError, SolverError) as exc:
+            # near the H∞ optimum the H2 channel's zero feedthrough and the common
+            # Lyapunov matrix can leave nothing, or too little for the solver
+            logger.info("h2hinfsyn: no point at ‖T∞‖∞ <= %.6g (%s)", gamma, exc)
+            return np.inf, None
+        return w_inf * gamma**2 + w_2 * r.objective_lmi**2, r
+
+    best = cost(hi)
+    for _ in range(_BRACKET_DOUBLINGS):  # the common Lyapunov matrix is conservative
+        if best[1] is not None:
+            break
+        hi *= 2.0
+        best = cost(hi)
+    else:
+        raise InfeasibleError(f"no controller has a finite H2 norm with ‖T∞‖∞ <= {hi:.6g} "
+                              "under a common Lyapunov matrix")
+    best = min((cost(lo), best), key=lambda c: c[0])
+    a, b = lo, hi
+    g = (np.sqrt(5) - 1) / 2
+    for _ in range(_GOLDEN_STEPS):
+        c1, c2 = b - g * (b - a), a + g * (b - a)
+        f1, f2 = cost(c1), cost(c2)
+        best = min((best, f1, f2), key=lambda c: c[0])
+        if f1[0] < f2[0]:
+            b = c2
+        else:
+            a = c1
+    return best[1]
+
+
+#: doublings of the upper end of that search until the mixed problem is feasible
+_BRACKET_DOUBLINGS = 8
+#: golden-section steps of the weighted mixed objective (the bracket shrinks to 0.6 %)
+_GOLDEN_STEPS = 10
