@@ -70,52 +70,82 @@ def _indices(sel, n: int, what: str) -> np.ndarray:
 class LmiVariables:
     """The synthesis variables and the closed-loop data they make affine.
 
-    ``calA`` is ``[[A Y + B2 Ĉ, A + B2 D̂ C2], [Â, X A + B̂ C2]]``, the image of the
-    closed-loop ``A`` under the congruence that linearises it; ``calX`` is
-    ``[[Y, I], [I, X]]``; :meth:`B`, :meth:`C` and :meth:`D` give the same for a channel.
-    A closed-loop inequality ``Aclᵀ P + P Acl ...`` with the common ``P`` becomes the same
-    inequality in these expressions (Scherer et al. 1997, Sec. III).
+    With the change of variables of Scherer et al. (1997, Sec. III), a closed-loop
+    inequality ``Aclᵀ P + P Acl ...`` in the common Lyapunov matrix ``P`` becomes the same
+    inequality in ``calA = [[A Y + B2 Ĉ, A + B2 D̂ C2], [Â, X A + B̂ C2]]``,
+    ``calX = [[Y, I], [I, X]]`` and, per channel, :meth:`B`, :meth:`C`, :meth:`D`.
+
+    Here every one of them is returned after a further congruence by ``diag(E, E)``,
+    ``E = diag(1 / scale)``, with the variables written relative to ``scale``
+    (``Y = S Ŷ S``, ``X = S X̂ S``, ``Â = S Â_r S``, ``B̂ = S B̂_r``, ``Ĉ = Ĉ_r S``,
+    ``S = diag(scale)``): in the frame of an earlier solution the variables are of order
+    one whatever the decades between the plant's modes (see
+    :class:`~lmi_suspension.synthesis.lmi.Frame`).  A congruence preserves definiteness,
+    so a specification writes its LMIs in these expressions exactly as in the textbook.
+    ``scale`` is all ones unless the synthesis sets a frame.
     """
 
-    X: cp.Variable
-    Y: cp.Variable
+    Xh: cp.Variable
+    Yh: cp.Variable
     Ah: cp.Variable
     Bh: cp.Variable
     Ch: cp.Variable
     Dh: cp.Variable
     data: dict = field(repr=False)
+    scale: np.ndarray = None
+
+    def __post_init__(self):
+        if self.scale is None:
+            self.scale = np.ones(self.Xh.shape[0])
 
     @property
     def n(self) -> int:
-        return self.X.shape[0]
+        return self.Xh.shape[0]
 
     @property
     def calA(self):
-        d = self.data
-        return cp.bmat([[d["A"] @ self.Y + d["B2"] @ self.Ch, d["A"] + d["B2"] @ self.Dh @ d["C2"]],
-                        [self.Ah, self.X @ d["A"] + self.Bh @ d["C2"]]])
+        d, s = self.data, self.scale
+        e = 1.0 / s
+        A, B2, C2 = d["A"], d["B2"], d["C2"]
+        return cp.bmat([[(e[:, None] * A * s[None, :]) @ self.Yh + (e[:, None] * B2) @ self.Ch,
+                         e[:, None] * A * e[None, :]
+                         + (e[:, None] * B2) @ self.Dh @ (C2 * e[None, :])],
+                        [self.Ah, self.Xh @ (s[:, None] * A * e[None, :])
+                         + self.Bh @ (C2 * e[None, :])]])
 
     @property
     def calX(self):
-        n = self.n
-        return _sym(cp.bmat([[self.Y, np.eye(n)], [np.eye(n), self.X]]))
+        e2 = np.diag(1.0 / self.scale**2)
+        return _sym(cp.bmat([[self.Yh, e2], [e2, self.Xh]]))
 
     def B(self, ch: Channel):
-        d = self.data
+        d, s = self.data, self.scale
         cols = ch.cols(d["B1"].shape[1])
         B1, D21 = d["B1"][:, cols], d["D21"][:, cols]
-        return cp.vstack([B1 + d["B2"] @ self.Dh @ D21, self.X @ B1 + self.Bh @ D21])
+        e = 1.0 / s
+        return cp.vstack([e[:, None] * B1 + (e[:, None] * d["B2"]) @ self.Dh @ D21,
+                          self.Xh @ (s[:, None] * B1) + self.Bh @ D21])
 
     def C(self, ch: Channel):
-        d = self.data
+        d, s = self.data, self.scale
         rows = ch.rows(d["C1"].shape[0])
         C1, D12 = d["C1"][rows], d["D12"][rows]
-        return cp.hstack([C1 @ self.Y + D12 @ self.Ch, C1 + D12 @ self.Dh @ d["C2"]])
+        e = 1.0 / s
+        return cp.hstack([(C1 * s[None, :]) @ self.Yh + D12 @ self.Ch,
+                          C1 * e[None, :] + D12 @ self.Dh @ (d["C2"] * e[None, :])])
 
     def D(self, ch: Channel):
         d = self.data
         rows, cols = ch.rows(d["C1"].shape[0]), ch.cols(d["B1"].shape[1])
         return d["D11"][np.ix_(rows, cols)] + d["D12"][rows] @ self.Dh @ d["D21"][:, cols]
+
+    def values(self) -> tuple:
+        """``(X, Y, Â, B̂, Ĉ, D̂)`` of the solution, in the plant's own scaling."""
+        s = self.scale
+        X = s[:, None] * self.Xh.value * s[None, :]
+        Y = s[:, None] * self.Yh.value * s[None, :]
+        return (_sym(X), _sym(Y), s[:, None] * self.Ah.value * s[None, :],
+                s[:, None] * self.Bh.value, self.Ch.value * s[None, :], self.Dh.value)
 
 
 @runtime_checkable
