@@ -1,9 +1,6 @@
 """Multi-objective LMI synthesis (``msyn``, ``h2hinfsyn``): every result is certified here
 again, on ``lft(P, K)`` alone, by computations that do not use the LMI variables."""
 
-import json
-from pathlib import Path
-
 import control
 import numpy as np
 import pytest
@@ -17,16 +14,7 @@ from lmi_suspension.synthesis.constraints import (Channel, Disk, H2Bound, HalfPl
                                                   HinfBound, PeakBound, Sector)
 from lmi_suspension.synthesis.examples import random_plant
 from lmi_suspension.synthesis.multiobjective import h2hinfsyn, msyn
-
-DATA = Path(__file__).parents[2] / "shared" / "data" / "compleib_subset.json"
-
-
-def compleib(name):
-    if not DATA.exists():
-        pytest.skip(f"COMPleib data not found at {DATA}")
-    v = json.loads(DATA.read_text())["problems"][name]
-    return GeneralizedPlant.from_matrices(v["A"], v["B1"], v["B"], v["C1"], v["C"],
-                                          v["D11"], v["D12"], v["D21"])
+from test_compleib import load  # COMPleib plants, read as that module reads them
 
 
 def h2_norm(A, B, C):
@@ -51,7 +39,7 @@ NAMES = ["AC2", "AC3", "AC4", "AC6", "HE1", "HE2", "REA1", "REA2", "DIS1", "NN1"
 def test_hinf_objective_alone_is_hinfsyns_lmi_optimum(name):
     """Reference: hinfsyn's γ minimisation over the projected LMIs (another
     formulation of the same problem), on COMPleib plants."""
-    P = compleib(name)
+    P = load(name)
     K, CL, gamma, info = msyn(P, P.ny, P.nu, HinfBound())
     ref = hinfsyn(P, P.ny, P.nu).gamma_lower
     assert gamma == hinfnorm(lft(P, K))[0]
@@ -80,7 +68,7 @@ def test_h2_objective_alone_is_the_riccati_h2_optimum(seed):
 
 
 def test_half_plane_tightens_the_objective_monotonically_and_is_certified():
-    P = compleib("HE1")
+    P = load("HE1")
     levels = []
     for alpha in (0.0, 0.2, 0.5, 1.0):
         K, CL, gamma, info = msyn(P, P.ny, P.nu, HinfBound(), [HalfPlane(alpha)])
@@ -103,7 +91,7 @@ def test_a_region_no_controller_reaches_is_a_typed_error():
 
 
 def test_disk_and_sector_are_certified_on_the_poles():
-    P = compleib("HE1")
+    P = load("HE1")
     K, CL, gamma, info = msyn(P, P.ny, P.nu, HinfBound(),
                               [Disk(radius=20.0, center=0.0), Sector(np.pi / 4)])
     p = np.linalg.eigvals(np.asarray(CL.A))
@@ -167,7 +155,7 @@ class DecayRate:
 
 
 def test_a_specification_of_ones_own_rides_in_the_synthesis():
-    P = compleib("HE2")
+    P = load("HE2")
     K, CL, gamma, info = msyn(P, P.ny, P.nu, HinfBound(), [DecayRate(0.3)])
     ref = msyn(P, P.ny, P.nu, HinfBound(), [HalfPlane(0.3)])
     assert np.max(np.linalg.eigvals(np.asarray(CL.A)).real) < -0.3

@@ -93,20 +93,22 @@ def compute_design(key: tuple, seed: int) -> dict:
                               metadata={"mu_peak": float(d.mu_peak)})
 
 
+def _blank_row(case: Case) -> dict:
+    """A case's key and values, every result column empty."""
+    return {"case": case.index, "controller": case.controller, **case.values,
+            **dict.fromkeys(METRIC_COLUMNS)}
+
+
 def error_row(case: Case, message: str) -> dict:
     """The row of a case that could not be evaluated."""
-    row = {"case": case.index, "controller": case.controller, **case.values}
-    row.update({c: None for c in METRIC_COLUMNS})
-    row.update(error=message, seconds=0.0)
-    return row
+    return {**_blank_row(case), "error": message, "seconds": 0.0}
 
 
 def evaluate_case(case: Case, K, road: str, settings: dict, limit: float | None) -> dict:
     """The row of one case (``K`` the controller, None for the passive seat;
     ``settings`` the road's, with the simulation ``step``)."""
     t0 = time.perf_counter()
-    row = {"case": case.index, "controller": case.controller, **case.values}
-    row.update({c: None for c in METRIC_COLUMNS})
+    row = _blank_row(case)
     try:
         p = _params(case.values)
         delay = float(case.values.get("delay", 0.0))

@@ -103,7 +103,7 @@ def plot_tradeoff(table, spec: SweepSpec):
                         cols["peak_z3dd"][sel].astype(float), c=c, s=14,
                         marker=markers[k % len(markers)], label=name,
                         **({} if c is None else {"cmap": "plasma"}))
-    ax.axvline(spec_zmax(spec) * 1e3, color="grey", ls="--", lw=1, label="stroke limit z_max")
+    ax.axvline(_z_max(spec) * 1e3, color="grey", ls="--", lw=1, label="stroke limit z_max")
     if color_axis is not None and sc is not None and ok.any():
         fig.colorbar(sc, ax=ax, label=_label(color_axis))
     ax.set_xlabel("peak |x1| [mm]")
@@ -114,7 +114,8 @@ def plot_tradeoff(table, spec: SweepSpec):
     return fig
 
 
-def spec_zmax(spec: SweepSpec) -> float:
+def _z_max(spec: SweepSpec) -> float:
+    """The stroke limit of the sweep (the largest, where it is an axis)."""
     from ..seat import SeatParameters
 
     for n, v in spec.grid:

@@ -192,12 +192,12 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
     for s in specs:
         if isinstance(s, (HinfBound, H2Bound)) and not (s.bound and s.bound > 0):
             raise ParameterError(f"{s.name} constraint needs a positive bound")
-    check_stabilizable(scale_plant(G)[0])
     if G.nstates == 0:
         raise ParameterError("msyn needs a plant with states")
     # the balanced plant with its inputs and outputs normalised; every norm scales by the
     # common factor f = cw / cz, which the bounds are converted with
     Ps, sc = scale_plant(G)
+    check_stabilizable(Ps)
     f = sc.gamma_factor
     n = Ps.nstates
     margin = opts.margin
