@@ -86,14 +86,7 @@ def save_controller(path, K, *, inputs=None, outputs=None, metadata=None) -> Pat
     path = Path(path)
     data = controller_to_dict(K, inputs=inputs, outputs=outputs, metadata=metadata)
 
-    def default(obj):  # numpy scalars and arrays in metadata
-        if isinstance(obj, np.generic):
-            return obj.item()
-        if isinstance(obj, np.ndarray):
-            return obj.tolist()
-        raise TypeError(f"cannot store {type(obj).__name__} in controller metadata")
-
-    text = json.dumps(data, indent=1, default=default, allow_nan=True)
+    text = json.dumps(data, indent=1, default=_json_default, allow_nan=True)
     path.write_text(text + "\n")
     return path
 
@@ -205,8 +198,9 @@ def load_controller_mat(path) -> tuple[control.StateSpace, tuple[list, list]]:
 
 
 def _json_default(obj):
+    """numpy scalars and arrays in metadata, as JSON numbers and lists."""
     if isinstance(obj, np.generic):
         return obj.item()
     if isinstance(obj, np.ndarray):
         return obj.tolist()
-    return str(obj)
+    raise TypeError(f"cannot store {type(obj).__name__} in controller metadata")

@@ -261,12 +261,20 @@ def _run_here(out, batches, controllers, spec, settings, keys, designs, progress
               on_batch) -> float:
     limits = {k: compute_limit(k) for k in keys}
     made = {k: compute_design(k, spec.seed) for k in designs}
-    total, n, compute = sum(len(b) for b in batches), 0, 0.0
-    for k, batch in enumerate(batches, start=1):
-        rows = evaluate_batch(batch, _used(controllers, batch), spec.road, settings,
-                              _needed(limits, batch, spec, settings), _designs(made, batch))
+    finished = ((batch, evaluate_batch(batch, _used(controllers, batch), spec.road, settings,
+                                       _needed(limits, batch, spec, settings),
+                                       _designs(made, batch)))
+                for batch in batches)
+    return _collect(out, finished, sum(len(b) for b in batches), progress, on_batch)
+
+
+def _collect(out, finished, total: int, progress, on_batch) -> float:
+    """Write each ``(batch, rows)`` as it arrives as its part; report progress; return the
+    sum of the cases' own times."""
+    n, compute = 0, 0.0
+    for k, (batch, rows) in enumerate(finished, start=1):
         _write_part(out, rows, _part_name(batch))
-        compute += sum(r["seconds"] for r in rows)
+        compute += sum(r["seconds"] or 0.0 for r in rows)
         n += len(batch)
         if progress is not None:
             progress(n, total)
@@ -319,28 +327,22 @@ def _run_dask(out, batches, controllers, spec, settings, keys, designs, schedule
                        for k in designs}
         futures = {}
         for batch in batches:
-            needed = {} if not spec.limit else {
-                k: limit_futs[k] for k in {limit_key(c, spec.road, settings) for c in batch}
-                if k is not None}
             fut = client.submit(evaluate_batch, batch, _used(controllers, batch), spec.road,
-                                settings, needed, _designs(design_futs, batch), pure=False,
-                                retries=2)
+                                settings, _needed(limit_futs, batch, spec, settings),
+                                _designs(design_futs, batch), pure=False, retries=2)
             futures[fut] = batch
-        total, n, compute = sum(len(b) for b in batches), 0, 0.0
-        for k, fut in enumerate(as_completed(list(futures)), start=1):
-            batch = futures[fut]
-            try:
-                rows = fut.result()
-            except Exception as exc:  # the batch itself failed (killed workers, ...)
-                logger.warning("sweep: batch %s failed: %s", _part_name(batch), exc)
-                rows = [error_row(c, f"{type(exc).__name__}: {exc}") for c in batch]
-            _write_part(out, rows, _part_name(batch))
-            compute += sum(r["seconds"] or 0.0 for r in rows)
-            n += len(batch)
-            if progress is not None:
-                progress(n, total)
-            if on_batch is not None:
-                on_batch(k)
+
+        def finished():
+            for fut in as_completed(list(futures)):
+                batch = futures[fut]
+                try:
+                    rows = fut.result()
+                except Exception as exc:  # the batch itself failed (killed workers, ...)
+                    logger.warning("sweep: batch %s failed: %s", _part_name(batch), exc)
+                    rows = [error_row(c, f"{type(exc).__name__}: {exc}") for c in batch]
+                yield batch, rows
+
+        compute = _collect(out, finished(), sum(len(b) for b in batches), progress, on_batch)
         return compute, n_workers
     finally:
         client.close()
