@@ -23,7 +23,7 @@ variable for the objective); ``slack`` is the margin every strict inequality kee
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Protocol, runtime_checkable
 
 import control
@@ -138,6 +138,18 @@ class LmiVariables:
         d = self.data
         rows, cols = ch.rows(d["C1"].shape[0]), ch.cols(d["B1"].shape[1])
         return d["D11"][np.ix_(rows, cols)] + d["D12"][rows] @ self.Dh @ d["D21"][:, cols]
+
+    def with_channel_scaled(self, rows: np.ndarray, row_factor: float, cols: np.ndarray,
+                            col_factor: float) -> "LmiVariables":
+        """The same variables for the plant whose performance outputs ``rows`` are
+        multiplied by ``row_factor`` and disturbance inputs ``cols`` by ``col_factor``
+        (a specification's channel in units of its own, see :func:`msyn`)."""
+        d = {k: np.array(m, dtype=float) for k, m in self.data.items()}
+        for key in ("C1", "D11", "D12"):
+            d[key][rows] *= row_factor
+        for key in ("B1", "D11", "D21"):
+            d[key][:, cols] *= col_factor
+        return replace(self, data=d)
 
     def values(self) -> tuple:
         """``(X, Y, Â, B̂, Ĉ, D̂)`` of the solution, in the plant's own scaling."""
@@ -256,7 +268,10 @@ class PeakBound:
         M1 = _sym(cp.bmat([[v.calA + v.calA.T, B], [B.T, -np.eye(nw)]]))
         cons = [M1 << -slack * np.eye(M1.shape[0])]
         for i, b in enumerate(self.bounds):
-            Mi = _sym(cp.bmat([[v.calX, C[i:i + 1].T], [C[i:i + 1], np.array([[b**2]])]]))
+            # C_i P⁻¹ C_iᵀ < b², written for the row C_i / b (a congruence): the entries
+            # stay of order one however small the bound is in the plant's units
+            Ci = C[i:i + 1] / b
+            Mi = _sym(cp.bmat([[v.calX, Ci.T], [Ci, np.ones((1, 1))]]))
             cons.append(Mi >> slack * np.eye(Mi.shape[0]))
         return cons + _no_feedthrough(v, self.channel, self.name)
 
