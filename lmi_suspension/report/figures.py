@@ -11,7 +11,8 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-__all__ = ["plot_mu_bounds", "plot_peak_vs_delay", "plot_responses", "plot_road"]
+__all__ = ["plot_bounded_response", "plot_force_tradeoff", "plot_mu_bounds",
+           "plot_peak_vs_delay", "plot_responses", "plot_road"]
 
 _LABELS = {
     "z3dd": ("upper-body acceleration $\\ddot z_3$", "m/s²"),
@@ -155,4 +156,89 @@ def plot_peak_vs_delay(delays: Sequence[float], peaks: Mapping[str, Sequence[flo
     # Outside the axes: seven entries inside would hide the curves of the worst controller.
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax.set_title(title)
+    return fig
+
+
+def plot_force_tradeoff(u_bounds: Sequence[float], hinf: Sequence[float],
+                        hinf_lmi: Sequence[float], bump_peak: Sequence[float],
+                        bump_force: Sequence[float], *, hinf_free: float | None = None,
+                        passive: float | None = None, limit: float | None = None,
+                        title: str = "") -> Figure:
+    """The price of a hard force bound (peak-bounded seat designs, issue 16).
+
+    Parameters
+    ----------
+    u_bounds : sequence of float
+        Force bounds, N (for every floor velocity of the bump's energy).
+    hinf, hinf_lmi : sequence of float
+        Certified H∞ level of each design and the level its LMIs guarantee.
+    bump_peak, bump_force : sequence of float
+        Peak ``|z̈3|`` and largest ``|u|`` of each linear closed loop on the bump.
+    hinf_free : float, optional
+        The H∞ optimum without bounds.
+    passive, limit : float, optional
+        The passive seat's bump peak and the physical limit (LP), m/s².
+
+    Examples
+    --------
+    >>> fig = plot_force_tradeoff([700, 1500], [39.3, 28.6], [39.6, 28.9], [24.4, 21.8],
+    ...                           [352.0, 732.0], hinf_free=23.2)
+    >>> len(fig.axes)
+    3
+    """
+    u = np.asarray(u_bounds, dtype=float)
+    fig = Figure(figsize=(11, 3.6), layout="constrained")
+    a1, a2, a3 = fig.subplots(1, 3, sharex=True)
+    a1.plot(u, hinf, "o-", label="certified (hinfnorm)")
+    a1.plot(u, hinf_lmi, "s--", mfc="none", label="LMI level")
+    if hinf_free is not None:
+        a1.axhline(hinf_free, color="0.45", ls=":", label="no bound")
+    a1.set_ylabel("$\\|w \\to [\\ddot z_3, \\rho u]\\|_\\infty$")
+    a2.plot(u, bump_peak, "o-", color="C2", label="bounded design")
+    if passive is not None:
+        a2.axhline(passive, color="0.45", ls="--", label="passive")
+    if limit is not None:
+        a2.axhline(limit, color="k", lw=2, label="physical limit (LP)")
+    a2.set_ylabel("peak $|\\ddot z_3|$ on the bump [m/s²]")
+    a2.set_ylim(bottom=0)
+    a3.plot(u, bump_force, "o-", color="C3", label="largest $|u|$ on the bump")
+    a3.plot(u, u, color="k", lw=1, label="bound")
+    a3.set_ylabel("force [N]")
+    for ax in (a1, a2, a3):
+        ax.set_xscale("log")
+        ax.set_xlabel("force bound $u_{max}$ [N]")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title)
+    return fig
+
+
+def plot_bounded_response(sim, *, u_max: float, z_max: float, title: str = "") -> Figure:
+    """A closed loop on the bump with the force and stroke bounds drawn: ``z̈3``,
+    commanded force and ``x1`` (nothing clipped unless the simulation clipped).
+
+    Examples
+    --------
+    >>> from lmi_suspension.seat import bump, simulate
+    >>> fig = plot_bounded_response(simulate(None, bump()), u_max=1500.0, z_max=0.08)
+    >>> len(fig.axes)
+    3
+    """
+    fig = Figure(figsize=(8, 6.5), layout="constrained")
+    axes = fig.subplots(3, 1, sharex=True)
+    for ax, (data, label, bound) in zip(axes, (
+            (sim.z3dd, "$\\ddot z_3$ [m/s²]", None),
+            (sim.u_command, "commanded $u$ [N]", u_max),
+            (sim.x1, "$x_1$ [m]", z_max))):
+        ax.plot(sim.t, data, color="k")
+        if bound is not None:
+            for sign in (1, -1):
+                ax.axhline(sign * bound, color="crimson", ls="--",
+                           label="bound" if sign > 0 else None)
+            ax.legend(fontsize=8, loc="upper right")
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+    axes[-1].set_xlabel("time [s]")
+    axes[-1].set_xlim(0, min(float(sim.t[-1]), 1.5))
+    fig.suptitle(title)
     return fig

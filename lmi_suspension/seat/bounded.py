@@ -28,7 +28,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import InfeasibleError, ParameterError
 from ..lti.plant import GeneralizedPlant
 from ..synthesis.constraints import Channel, HinfBound, PeakBound
 from ..synthesis.multiobjective import MultiobjectiveResult, msyn
@@ -165,8 +165,13 @@ def design_peak_bounded(u_max: float = 1500.0, z_max: float = 0.08, *,
         # one specification for both rows: they are driven by the same floor velocity
         constraints.append(PeakBound(Channel(outputs=tuple(r for r, _ in rows), inputs=(0,)),
                                      tuple(b / E for _, b in rows), name="peak u, x1"))
-    res = msyn(P, 2, 1, HinfBound(Channel(outputs=(Z3DD, RHO_U))), constraints,
-               lyapunov_scales=lyapunov_scales)
+    try:
+        res = msyn(P, 2, 1, HinfBound(Channel(outputs=(Z3DD, RHO_U))), constraints,
+                   lyapunov_scales=lyapunov_scales)
+    except InfeasibleError as exc:
+        raise InfeasibleError(f"no controller keeps |u| <= {u_max:g} N and |x1| <= "
+                              f"{z_max:g} m for every floor velocity of energy {E:.4g} "
+                              f"(with a common Lyapunov matrix): {exc}") from exc
     peaks = PeakBound(Channel(outputs=(U, X1), inputs=(0,)), (1.0, 1.0)).peaks(res.CL) * E
     K = control.ss(res.K.A, res.K.B, res.K.C, res.K.D, inputs=["x1", "x3"], outputs=["u"],
                    name="K_peak")

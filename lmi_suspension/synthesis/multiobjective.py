@@ -55,6 +55,9 @@ _NARROW_SIGMA_CAP = 100.0
 _RECONSTRUCTION_STEPS = 4
 #: the certificate may exceed the LMI level by this much before the result is an error
 _CERT_RTOL = 5e-3
+#: the constraints are reported infeasible when their largest common margin (scaled
+#: data, trace box xy_bound) is below this
+_FEASIBLE_MARGIN = 1e-7
 
 
 @dataclass(frozen=True)
@@ -245,8 +248,9 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
                                      factor[k] / sc.gamma_factor / r,
                                      spec.channel.cols(Ps.nw), r)
 
-    def build(v, obj_level, slack, coupling, with_constraints=True):
-        cons = list(objective.lmis(view(v, 0, objective), obj_level, slack))
+    def build(v, obj_level, slack, coupling, with_constraints=True, objective=objective):
+        cons = list(objective.lmis(view(v, 0, objective), obj_level, slack)) if objective \
+            else []
         for k, s in enumerate(specs if with_constraints else (), start=1):
             lv = None if s.bound is None or isinstance(s, PeakBound) else \
                 scaled_level(k, s, s.bound)
@@ -386,6 +390,21 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
             break
         if done is not None:
             break
+    if done is None and all("no strictly feasible point" in w for w in warnings
+                            if w.startswith("reconstruction at")):
+        # no rung had a strictly feasible point: ask the constraints alone
+        v = _variables(Ps)
+        cons = build(v, None, _SLACK_WEIGHT * t, t, objective=False)
+        cons += [cp.trace(v.Xh) + cp.trace(v.Yh) <= opts.xy_bound * n, t <= 1.0]
+        try:
+            status, _ = _lmi._solve(cp.Problem(cp.Maximize(t), cons), opts,
+                                    "multi-objective feasibility", warnings)
+        except SolverError:
+            status = None
+        logger.info("msyn: constraints alone: status %s, margin %s", status, t.value)
+        if status in _lmi._INFEASIBLE or (t.value is not None and t.value <= _FEASIBLE_MARGIN):
+            raise InfeasibleError(_infeasible_message(specs) + f" (largest common margin of "
+                                  f"the constraints alone: {t.value})")
     if done is None:
         raise SolverError(f"multi-objective synthesis: no certified controller after "
                           f"{_RECONSTRUCTION_STEPS} relaxations (last: {last})")
@@ -420,7 +439,12 @@ _ALPHA_GOLDEN_STEPS = 8
 
 
 def _infeasible_message(specs) -> str:
-    names = ", ".join(f"{s.name}" + (f" <= {s.bound:g}" if s.bound else "") for s in specs)
+    def asked(s):
+        if isinstance(s, PeakBound):
+            return " <= (" + ", ".join(f"{b:g}" for b in s.bounds) + ")"
+        return f" <= {s.bound:g}" if s.bound else ""
+
+    names = ", ".join(f"{s.name}{asked(s)}" for s in specs)
     return (f"no controller meets the constraints ({names or 'none'}) with a common "
             "Lyapunov matrix")
 
