@@ -10,6 +10,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import NullFormatter
 
 __all__ = ["plot_bounded_response", "plot_force_tradeoff", "plot_mu_bounds",
            "plot_peak_vs_delay", "plot_responses", "plot_road"]
@@ -206,6 +207,8 @@ def plot_force_tradeoff(u_bounds: Sequence[float], hinf: Sequence[float],
     a3.set_ylabel("force [N]")
     for ax in (a1, a2, a3):
         ax.set_xscale("log")
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.set_xticks(u, [f"{x:g}" for x in u], rotation=60, fontsize=8)
         ax.set_xlabel("force bound $u_{max}$ [N]")
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)

@@ -19,6 +19,16 @@ The protocol (:class:`Specification`)::
 ``level`` is the CVXPY expression of the bound (a constant for a constraint, the objective
 variable for the objective); ``slack`` is the margin every strict inequality keeps
 (``L <= -slack I``), which the synthesis maximises when it reconstructs the controller.
+
+A specification with a ``channel`` (:class:`Channel`) may set ``lyapunov_scalable = True``
+when its bound is a norm of the channel (it scales with the channel's outputs) and its
+LMIs certify it for the Lyapunov matrix ``alpha P`` as well as for ``P`` -- true of the
+bounded-real and energy-to-peak forms, where ``alpha P`` amounts to the channel's inputs
+times ``sqrt(alpha)`` and its outputs divided by it.  :func:`msyn` then treats it as the
+norm bounds it ships: its channel's outputs in units of their own size, and ``alpha``
+searched.  With one Lyapunov matrix for every specification, that scale decides how much
+a constraint costs (on the seat, the H∞ level under the peak bounds was 685 at
+``alpha = 1`` and 28.9 at the best scale).
 """
 
 from __future__ import annotations

@@ -241,7 +241,7 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
     alpha = [1.0] + _given_scales(lyapunov_scales, specs)
 
     def view(v, k, spec):
-        if not isinstance(spec, _CHANNEL_SPECS):
+        if not _scalable(spec):
             return v
         r = np.sqrt(alpha[k])
         return v.with_channel_scaled(spec.channel.rows(Ps.nz),
@@ -281,7 +281,7 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
     identity = _lmi.Frame.identity(n)
     first = identity
     searched = [k for k, s in enumerate(specs, start=1)
-                if isinstance(s, _CHANNEL_SPECS) and lyapunov_scales is None]
+                if _scalable(s) and lyapunov_scales is None]
     if searched:
         # the search runs in the frame of the objective's optimum alone
         alone = minimise(identity, with_constraints=False)
@@ -427,6 +427,14 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
 
 _CHANNEL_SPECS = (HinfBound, H2Bound, PeakBound)
 
+
+def _scalable(spec) -> bool:
+    """Whether ``spec`` takes a Lyapunov scale of its own: the norm specifications, and
+    one's own with a ``channel`` that declares ``lyapunov_scalable = True``."""
+    return isinstance(spec, _CHANNEL_SPECS) or (
+        getattr(spec, "lyapunov_scalable", False) and isinstance(getattr(spec, "channel", None),
+                                                                 Channel))
+
 #: the Lyapunov scale of a norm constraint is searched over log10(alpha) in
 #: start +- _ALPHA_DECADES (start = -log10 of the objective's optimum alone, where the
 #: objective's bounded-real inequality, divided by its level, is the constraint's own
@@ -508,7 +516,7 @@ def _search_alpha(level, start: float) -> float:
 def _channel_size(Ps: GeneralizedPlant, spec) -> float:
     """The size ``‖[C1 D11 D12]‖₂`` of a norm specification's outputs in the balanced
     plant (1 for other specifications and for outputs that are identically zero)."""
-    if not isinstance(spec, _CHANNEL_SPECS):
+    if not _scalable(spec):
         return 1.0
     d = Ps.blocks()
     rows, cols = spec.channel.rows(Ps.nz), spec.channel.cols(Ps.nw)
