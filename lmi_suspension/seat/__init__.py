@@ -15,6 +15,7 @@ from .comfort import ComfortMetrics, comfort_metrics, vdv, weighted_rms, wk_filt
 from .simulate import (MonteCarloResult, SimulationMetrics, SimulationResult, closed_loop_stable,
                        loop_transfer, monte_carlo, simulate, simulate_force, stability_delay_margin)
 from .limit import LimitResult, bump_limit
+from .bounded import PeakBoundedDesign, design_peak_bounded, road_energy
 
 __all__ = [
     "SeatParameters", "SeatMatrices", "seat_matrices", "seat_model", "natural_modes",
@@ -27,4 +28,5 @@ __all__ = [
     "SimulationResult", "SimulationMetrics", "MonteCarloResult", "simulate", "simulate_force",
     "closed_loop_stable", "loop_transfer", "stability_delay_margin", "monte_carlo",
     "LimitResult", "bump_limit",
+    "PeakBoundedDesign", "design_peak_bounded", "road_energy",
 ]
