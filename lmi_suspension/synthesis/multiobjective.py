@@ -220,7 +220,10 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
     # the acceleration row -- its squared H2 level (4e-10) sat below Clarabel's tolerances
     # and the stroke's peak bound left no strictly feasible point
     # (index 0 is the objective, k the constraint k - 1)
-    factor = [sc.gamma_factor / _channel_size(Ps, s) for s in [objective, *specs]]
+    # The objective keeps the plant's own scaling: its level is a variable, and H∞ alone
+    # must stay hinfsyn's LMI (normalised, COMPleib HE1 needed a recovery in every round
+    # under OpenBLAS's SkylakeX kernel, 2026-11-26)
+    factor = [sc.gamma_factor] + [sc.gamma_factor / _channel_size(Ps, s) for s in specs]
 
     def scaled_level(k, spec, value):
         x = value * factor[k]
@@ -241,7 +244,7 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
     alpha = [1.0] + _given_scales(lyapunov_scales, specs)
 
     def view(v, k, spec):
-        if not _scalable(spec):
+        if k == 0 or not _scalable(spec):
             return v
         r = np.sqrt(alpha[k])
         return v.with_channel_scaled(spec.channel.rows(Ps.nz),
