@@ -27,8 +27,8 @@ bounded-real and energy-to-peak forms, where ``alpha P`` amounts to the channel'
 times ``sqrt(alpha)`` and its outputs divided by it.  :func:`msyn` then treats it as the
 norm bounds it ships: its channel's outputs in units of their own size, and ``alpha``
 searched.  With one Lyapunov matrix for every specification, that scale decides how much
-a constraint costs (on the seat, the H∞ level under the peak bounds was 685 at
-``alpha = 1`` and 28.9 at the best scale).
+a constraint costs (on the seat at 1500 N / 0.08 m, the LMI's H∞ level was 96 at
+``alpha = 10``, 30.4 at 100, 121 at 1000, and 28.9 at the scale found).
 """
 
 from __future__ import annotations

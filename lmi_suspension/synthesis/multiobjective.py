@@ -164,7 +164,8 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
     lyapunov_scales : sequence of float, optional
         One per constraint: the scale ``alpha`` of the Lyapunov matrix with which each
         norm constraint enters (``alpha P``, ``P`` the common matrix; ignored for pole
-        regions and specifications of one's own).  By default each is searched, over
+        regions, and for specifications of one's own unless they declare
+        ``lyapunov_scalable``).  By default each is searched, over
         six decades, for the lowest objective; a result's ``lyapunov_scales`` can be
         passed back to skip that search in a sweep of nearby problems.
 
@@ -214,15 +215,14 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
     check_stabilizable(Ps)
     n = Ps.nstates
     margin = opts.margin
-    # every norm specification is written for its channel's outputs divided by their own
-    # size in the balanced plant, so that its level is of order one: the plant's common
-    # output scaling is set by its largest rows, and on the seat the stroke row is 1e-3 of
-    # the acceleration row -- its squared H2 level (4e-10) sat below Clarabel's tolerances
-    # and the stroke's peak bound left no strictly feasible point
-    # (index 0 is the objective, k the constraint k - 1)
-    # The objective keeps the plant's own scaling: its level is a variable, and H∞ alone
-    # must stay hinfsyn's LMI (normalised, COMPleib HE1 needed a recovery in every round
-    # under OpenBLAS's SkylakeX kernel, 2026-11-26)
+    # Index 0 is the objective, k the constraint k - 1.  Every norm constraint is written
+    # for its channel's outputs divided by their own size in the balanced plant, so that
+    # its level is of order one: the plant's common output scaling is set by its largest
+    # rows, and on the seat the stroke row is 1e-3 of the acceleration row -- its squared
+    # H2 level (4e-10) sat below Clarabel's tolerances and the stroke's peak bound left no
+    # strictly feasible point.  The objective keeps the plant's own scaling: its level is
+    # a variable, and H∞ alone must stay hinfsyn's LMI (normalised, COMPleib HE1 needed a
+    # recovery in every round under OpenBLAS's SkylakeX kernel, 2026-11-26).
     factor = [sc.gamma_factor] + [sc.gamma_factor / _channel_size(Ps, s) for s in specs]
 
     def scaled_level(k, spec, value):
@@ -251,9 +251,9 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
                                      factor[k] / sc.gamma_factor / r,
                                      spec.channel.cols(Ps.nw), r)
 
-    def build(v, obj_level, slack, coupling, with_constraints=True, objective=objective):
-        cons = list(objective.lmis(view(v, 0, objective), obj_level, slack)) if objective \
-            else []
+    def build(v, obj_level, slack, coupling, with_constraints=True, with_objective=True):
+        cons = list(objective.lmis(view(v, 0, objective), obj_level, slack)) \
+            if with_objective else []
         for k, s in enumerate(specs if with_constraints else (), start=1):
             lv = None if s.bound is None or isinstance(s, PeakBound) else \
                 scaled_level(k, s, s.bound)
@@ -350,6 +350,7 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
     t = cp.Variable()
     done = None
     last = "no attempt"
+    no_interior = True  # every rung so far found no strictly feasible point
     # each rung: a solve, then the controller, its stability and every certificate; a
     # rung that fails any of them hands over to the next (COMPleib AC2 under OpenBLAS's
     # Sandybridge kernel left a closed-loop pole at +3.6e-12 in the first frame)
@@ -366,11 +367,13 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
             except SolverError as exc:
                 last = f"reconstruction at {target:.6g} (scaled) failed: {exc}"
                 warnings.append(last)
+                no_interior = False
                 continue
             if status in _lmi._INFEASIBLE or t.value is None or t.value <= 0:
                 last = f"reconstruction at {target:.6g} (scaled): no strictly feasible point"
                 warnings.append(last)
                 continue
+            no_interior = False
             _zero_feedthrough(v, [objective, *specs])
             K = sc.controller_to_original(_controller(v))
             CL = lft(G, K)
@@ -393,11 +396,10 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
             break
         if done is not None:
             break
-    if done is None and all("no strictly feasible point" in w for w in warnings
-                            if w.startswith("reconstruction at")):
+    if done is None and no_interior:
         # no rung had a strictly feasible point: ask the constraints alone
         v = _variables(Ps)
-        cons = build(v, None, _SLACK_WEIGHT * t, t, objective=False)
+        cons = build(v, None, _SLACK_WEIGHT * t, t, with_objective=False)
         cons += [cp.trace(v.Xh) + cp.trace(v.Yh) <= opts.xy_bound * n, t <= 1.0]
         try:
             status, _ = _lmi._solve(cp.Problem(cp.Maximize(t), cons), opts,
@@ -438,13 +440,15 @@ def _scalable(spec) -> bool:
         getattr(spec, "lyapunov_scalable", False) and isinstance(getattr(spec, "channel", None),
                                                                  Channel))
 
+
 #: the Lyapunov scale of a norm constraint is searched over log10(alpha) in
 #: start +- _ALPHA_DECADES (start = -log10 of the objective's optimum alone, where the
 #: objective's bounded-real inequality, divided by its level, is the constraint's own
 #: form): first on a grid of one decade, then by golden section around the best point.
-#: On the seat (H∞ of the acceleration with peak bounds on force and stroke) the LMI
-#: optimum was 685 at alpha = 1, 30.4 at alpha = 100 and 120 at alpha = 1000; the
-#: objective alone is 23.2 (2026-11-26)
+#: On the seat (H∞ of the acceleration, peak bounds 1500 N and 0.08 m, channels in their
+#: own units) the LMI optimum was 96 at alpha = 10, 30.4 at 100 and 121 at 1000 (none
+#: certified at alpha = 1), 28.9 after the search; the objective alone is 23.2
+#: (2026-11-26).  1/23.2 in the balanced plant's units is alpha = 115
 _ALPHA_DECADES = 3
 _ALPHA_GOLDEN_STEPS = 8
 
