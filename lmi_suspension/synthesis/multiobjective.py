@@ -446,9 +446,9 @@ def _scalable(spec) -> bool:
 #: objective's bounded-real inequality, divided by its level, is the constraint's own
 #: form): first on a grid of one decade, then by golden section around the best point.
 #: On the seat (H∞ of the acceleration, peak bounds 1500 N and 0.08 m, channels in their
-#: own units) the LMI optimum was 96 at alpha = 10, 30.4 at 100 and 121 at 1000 (none
-#: certified at alpha = 1), 28.9 after the search; the objective alone is 23.2
-#: (2026-11-26).  1/23.2 in the balanced plant's units is alpha = 115
+#: own units) the LMI optimum was 96 at alpha = 10, 30.4 at 100 and 121 at 1000 (at 1
+#: every minimisation needed a solver recovery; its controller certified 52.8), 28.9
+#: after the search; the objective alone is 23.2 (2026-11-26)
 _ALPHA_DECADES = 3
 _ALPHA_GOLDEN_STEPS = 8
 
