@@ -44,7 +44,7 @@ import scipy.linalg
 from ..errors import DimensionError, ParameterError
 from ..lti.norms import hinfnorm
 
-__all__ = ["Specification", "LmiVariables", "Channel", "HinfBound", "H2Bound", "PeakBound",
+__all__ = ["Specification", "LmiVariables", "StateFeedbackVariables", "Channel", "HinfBound", "H2Bound", "PeakBound",
            "HalfPlane", "Disk", "Sector"]
 
 
@@ -149,17 +149,18 @@ class LmiVariables:
         rows, cols = ch.rows(d["C1"].shape[0]), ch.cols(d["B1"].shape[1])
         return d["D11"][np.ix_(rows, cols)] + d["D12"][rows] @ self.Dh @ d["D21"][:, cols]
 
+    @property
+    def lyapunov_trace(self):
+        """``trace(X̂) + trace(Ŷ)``, which the synthesis bounds."""
+        return cp.trace(self.Xh) + cp.trace(self.Yh)
+
     def with_channel_scaled(self, rows: np.ndarray, row_factor: float, cols: np.ndarray,
                             col_factor: float) -> "LmiVariables":
         """The same variables for the plant whose performance outputs ``rows`` are
         multiplied by ``row_factor`` and disturbance inputs ``cols`` by ``col_factor``
         (a specification's channel in units of its own, see :func:`msyn`)."""
-        d = {k: np.array(m, dtype=float) for k, m in self.data.items()}
-        for key in ("C1", "D11", "D12"):
-            d[key][rows] *= row_factor
-        for key in ("B1", "D11", "D21"):
-            d[key][:, cols] *= col_factor
-        return replace(self, data=d)
+        return replace(self, data=_channel_scaled(self.data, rows, row_factor, cols,
+                                                  col_factor))
 
     def values(self) -> tuple:
         """``(X, Y, Â, B̂, Ĉ, D̂)`` of the solution, in the plant's own scaling."""
@@ -168,6 +169,89 @@ class LmiVariables:
         Y = s[:, None] * self.Yh.value * s[None, :]
         return (_sym(X), _sym(Y), s[:, None] * self.Ah.value * s[None, :],
                 s[:, None] * self.Bh.value, self.Ch.value * s[None, :], self.Dh.value)
+
+
+def _channel_scaled(data: dict, rows, row_factor: float, cols, col_factor: float) -> dict:
+    d = {k: np.array(m, dtype=float) for k, m in data.items()}
+    for key in ("C1", "D11", "D12"):
+        d[key][rows] *= row_factor
+    for key in ("B1", "D11", "D21"):
+        d[key][:, cols] *= col_factor
+    return d
+
+
+@dataclass
+class StateFeedbackVariables:
+    """The variables of static state feedback ``u = K x`` (:func:`~.statefeedback.msfsyn`),
+    with the interface of :class:`LmiVariables`, so that every specification serves both.
+
+    With ``Y = P⁻¹`` and ``L = K Y`` (the congruence by ``Y`` of the closed-loop
+    inequality in ``P``), the closed-loop data are affine: ``calA = A Y + B2 L``,
+    ``calX = Y``, and per channel ``B = B1``, ``C = C1 Y + D12 L``, ``D = D11``.  The
+    plant's measurements are its states in some coordinates, ``y = C2 x`` with ``C2``
+    invertible, so that ``K_y = L Y⁻¹ C2⁻¹``.  As in :class:`LmiVariables` the variables
+    are relative to ``scale`` (``Y = S Ŷ S``, ``L = L̂ S``) and the expressions are
+    returned after the congruence by ``S⁻¹``.
+    """
+
+    Yh: cp.Variable
+    Lh: cp.Variable
+    data: dict = field(repr=False)
+    scale: np.ndarray = None
+
+    def __post_init__(self):
+        if self.scale is None:
+            self.scale = np.ones(self.Yh.shape[0])
+
+    @property
+    def n(self) -> int:
+        return self.Yh.shape[0]
+
+    @property
+    def calA(self):
+        d, s = self.data, self.scale
+        e = 1.0 / s
+        return (e[:, None] * d["A"] * s[None, :]) @ self.Yh + (e[:, None] * d["B2"]) @ self.Lh
+
+    @property
+    def calX(self):
+        return _sym(self.Yh)
+
+    @property
+    def lyapunov_trace(self):
+        return cp.trace(self.Yh)
+
+    def B(self, ch: Channel):
+        d = self.data
+        return (1.0 / self.scale)[:, None] * d["B1"][:, ch.cols(d["B1"].shape[1])]
+
+    def C(self, ch: Channel):
+        d = self.data
+        rows = ch.rows(d["C1"].shape[0])
+        return (d["C1"][rows] * self.scale[None, :]) @ self.Yh + d["D12"][rows] @ self.Lh
+
+    def D(self, ch: Channel):
+        d = self.data
+        rows, cols = ch.rows(d["C1"].shape[0]), ch.cols(d["B1"].shape[1])
+        return d["D11"][np.ix_(rows, cols)]
+
+    def with_channel_scaled(self, rows, row_factor: float, cols,
+                            col_factor: float) -> "StateFeedbackVariables":
+        """See :meth:`LmiVariables.with_channel_scaled`."""
+        return replace(self, data=_channel_scaled(self.data, rows, row_factor, cols,
+                                                  col_factor))
+
+    def values(self) -> tuple:
+        """``(Y⁻¹, Y, L)`` of the solution in the plant's own scaling (the first two in
+        the places of :meth:`LmiVariables.values`' ``X, Y``)."""
+        s = self.scale
+        Y = _sym(s[:, None] * self.Yh.value * s[None, :])
+        return _sym(np.linalg.inv(Y)), Y, self.Lh.value * s[None, :]
+
+    def gain(self) -> np.ndarray:
+        """``K_y = L Y⁻¹ C2⁻¹``: the static gain from the measurements ``y = C2 x``."""
+        _, Y, L = self.values()
+        return np.linalg.solve(self.data["C2"].T, np.linalg.solve(Y, L.T)).T
 
 
 @runtime_checkable

@@ -55,6 +55,8 @@ _NARROW_SIGMA_CAP = 100.0
 _RECONSTRUCTION_STEPS = 4
 #: the certificate may exceed the LMI level by this much before the result is an error
 _CERT_RTOL = 5e-3
+#: a reconstruction this far above the optimum gets a warning in the result
+_FAR_ABOVE = 1e-2
 #: the constraints are reported infeasible when their largest common margin (scaled
 #: data, trace box xy_bound) is below this
 _FEASIBLE_MARGIN = 1e-7
@@ -192,11 +194,38 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
     True
     """
     t0 = time.perf_counter()
-    opts = HinfsynOptions() if options is None else options
     G = GeneralizedPlant.from_statespace(
         P if isinstance(P, GeneralizedPlant) else as_statespace(P, "P"), nmeas, ncon)
     if np.any(G.blocks()["D22"]):
         raise ParameterError("msyn needs D22 = 0 (loop shifting is not implemented here)")
+    return _synthesise(G, objective, constraints, options, lyapunov_scales, _OUTPUT_FEEDBACK,
+                       t0)
+
+
+@dataclass(frozen=True)
+class _Form:
+    """What distinguishes a controller structure in :func:`_synthesise`: its LMI
+    variables (``variables(plant, scale)``, with the interface of
+    :class:`~.constraints.LmiVariables`) and the controller of a solution
+    (``controller(v, specs)``, of the scaled plant)."""
+
+    variables: object
+    controller: object
+
+
+def _output_feedback_controller(v: LmiVariables, specs) -> control.StateSpace:
+    _zero_feedthrough(v, specs)
+    return _controller(v)
+
+
+_OUTPUT_FEEDBACK = _Form(_variables, _output_feedback_controller)
+
+
+def _synthesise(G: GeneralizedPlant, objective, constraints, options, lyapunov_scales,
+                form: _Form, t0: float) -> MultiobjectiveResult:
+    """The body of :func:`msyn` and :func:`~.statefeedback.msfsyn`: minimise, frame
+    rounds, reconstruction ladder, certificates."""
+    opts = HinfsynOptions() if options is None else options
     specs = list(constraints)
     for s in [objective, *specs]:
         if not isinstance(s, Specification):
@@ -258,7 +287,7 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
             lv = None if s.bound is None or isinstance(s, PeakBound) else \
                 scaled_level(k, s, s.bound)
             cons += scaled_spec(k, s).lmis(view(v, k, s), lv, slack)
-        cons.append(v.calX >> coupling * np.eye(2 * n))
+        cons.append(v.calX >> coupling * np.eye(v.calX.shape[0]))
         return cons
 
     def minimise(frame, with_constraints=True):
@@ -266,10 +295,10 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
         variables relative to its scale): ``(level, Y, X, clean)`` or None if
         infeasible."""
         Pf = transform_states(Ps, frame.T)
-        v = _variables(Pf, frame.scale)
+        v = form.variables(Pf, frame.scale)
         level = cp.Variable(nonneg=True)
         cons = build(v, level, margin, margin, with_constraints)
-        cons.append(cp.trace(v.Xh) + cp.trace(v.Yh) <= opts.xy_bound * n)
+        cons.append(v.lyapunov_trace <= opts.xy_bound * n)
         status, recoveries = _lmi._solve(cp.Problem(cp.Minimize(level), cons), opts,
                                          "multi-objective minimisation", warnings)
         if status in _lmi._INFEASIBLE or level.value is None:
@@ -279,6 +308,22 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
         Ti = np.linalg.inv(frame.T)
         clean = recoveries == 0 and status in _lmi._OK
         return float(level.value), frame.T @ Yb @ frame.T.T, Ti.T @ Xb @ Ti, clean
+
+    def raise_if_infeasible():
+        """InfeasibleError if the constraints alone have no strictly feasible point."""
+        t = cp.Variable()
+        v = form.variables(Ps, None)
+        cons = build(v, None, _SLACK_WEIGHT * t, t, with_objective=False)
+        cons += [v.lyapunov_trace <= opts.xy_bound * n, t <= 1.0]
+        try:
+            status, _ = _lmi._solve(cp.Problem(cp.Maximize(t), cons), opts,
+                                    "multi-objective feasibility", warnings)
+        except SolverError:
+            status = None
+        logger.info("msyn: constraints alone: status %s, margin %s", status, t.value)
+        if status in _lmi._INFEASIBLE or (t.value is not None and t.value <= _FEASIBLE_MARGIN):
+            raise InfeasibleError(_infeasible_message(specs) + f" (largest common margin of "
+                                  f"the constraints alone: {t.value})")
 
     warnings: list[str] = []
     identity = _lmi.Frame.identity(n)
@@ -302,6 +347,10 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
             if not any(isinstance(x, float) for x in outcomes):
                 if "infeasible" in outcomes:
                     raise InfeasibleError(_infeasible_message(specs))
+                # Clarabel failed at every scale: whether it reports a far too tight bound
+                # infeasible or fails depends on the BLAS kernel (a peak bound of 1e-9
+                # under Haswell, 2026-11-25), the largest common margin does not
+                raise_if_infeasible()
                 raise SolverError(f"multi-objective minimisation: Clarabel failed for every "
                                   f"Lyapunov scale of {specs[k - 1].name}")
     found = minimise(first)
@@ -350,32 +399,30 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
     t = cp.Variable()
     done = None
     last = "no attempt"
-    no_interior = True  # every rung so far found no strictly feasible point
+    no_interior = True  # no rung so far found a strictly feasible point (or failed)
     # each rung: a solve, then the controller, its stability and every certificate; a
     # rung that fails any of them hands over to the next (COMPleib AC2 under OpenBLAS's
     # Sandybridge kernel left a closed-loop pole at +3.6e-12 in the first frame)
     for step in range(_RECONSTRUCTION_STEPS):
         for frame, base, trace in frames:
             target = base * (1 + _LEVEL_RELAX * 4.0**step) + opts.gamma_atol
-            v = _variables(transform_states(Ps, frame.T), frame.scale)
+            v = form.variables(transform_states(Ps, frame.T), frame.scale)
             box = _TRACE_BOX * 10.0**step * trace
             cons = build(v, target, _SLACK_WEIGHT * t, t)
-            cons += [cp.trace(v.Xh) + cp.trace(v.Yh) <= box, t <= 1.0]
+            cons += [v.lyapunov_trace <= box, t <= 1.0]
             try:
                 status, _ = _lmi._solve(cp.Problem(cp.Maximize(t), cons), opts,
                                         "multi-objective reconstruction", warnings, refine=True)
             except SolverError as exc:
                 last = f"reconstruction at {target:.6g} (scaled) failed: {exc}"
                 warnings.append(last)
-                no_interior = False
                 continue
             if status in _lmi._INFEASIBLE or t.value is None or t.value <= 0:
                 last = f"reconstruction at {target:.6g} (scaled): no strictly feasible point"
                 warnings.append(last)
                 continue
             no_interior = False
-            _zero_feedthrough(v, [objective, *specs])
-            K = sc.controller_to_original(_controller(v))
+            K = sc.controller_to_original(form.controller(v, [objective, *specs]))
             CL = lft(G, K)
             poles = np.linalg.eigvals(np.asarray(CL.A))
             if not np.all(poles.real < 0):
@@ -398,18 +445,7 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
             break
     if done is None and no_interior:
         # no rung had a strictly feasible point: ask the constraints alone
-        v = _variables(Ps)
-        cons = build(v, None, _SLACK_WEIGHT * t, t, with_objective=False)
-        cons += [cp.trace(v.Xh) + cp.trace(v.Yh) <= opts.xy_bound * n, t <= 1.0]
-        try:
-            status, _ = _lmi._solve(cp.Problem(cp.Maximize(t), cons), opts,
-                                    "multi-objective feasibility", warnings)
-        except SolverError:
-            status = None
-        logger.info("msyn: constraints alone: status %s, margin %s", status, t.value)
-        if status in _lmi._INFEASIBLE or (t.value is not None and t.value <= _FEASIBLE_MARGIN):
-            raise InfeasibleError(_infeasible_message(specs) + f" (largest common margin of "
-                                  f"the constraints alone: {t.value})")
+        raise_if_infeasible()
     if done is None:
         raise SolverError(f"multi-objective synthesis: no certified controller after "
                           f"{_RECONSTRUCTION_STEPS} relaxations (last: {last})")
@@ -418,6 +454,14 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
     if bound_level is None:
         warnings.append("every minimisation needed a solver recovery: no LMI lower bound "
                         "is reported (objective_lmi is nan)")
+    elif certs[0].lmi_level > lmi_level * (1 + _FAR_ABOVE):
+        # every rung near the optimum failed: typically an infimum that no controller
+        # attains (state feedback on COMPleib AC2: a mode at s = 0 that z does not see,
+        # the controllers near the optimum leave a closed-loop pole at -7e-7)
+        warnings.append(f"the controller was reconstructed at {certs[0].lmi_level:.6g}, "
+                        f"{certs[0].lmi_level / lmi_level - 1:.1%} above the LMI optimum "
+                        f"{lmi_level:.6g}: the optimum may not be attained (slowest "
+                        f"closed-loop pole {np.max(poles.real):.3g})")
     elif not specs and certs[0].achieved < lmi_level * (1 - _CERT_RTOL):
         # (with constraints the controller's own norm may well be below the level that
         # the common Lyapunov matrix guarantees)
