@@ -102,7 +102,9 @@ def test_bounds_no_controller_meets_are_a_typed_error_within_seconds():
     t0 = time.perf_counter()
     with pytest.raises(InfeasibleError, match="1 N"):
         design_peak_bounded(1.0, 0.01)
-    assert time.perf_counter() - t0 < 30.0
+    # each constraint is asked alone before the Lyapunov-scale search: 0.09 s measured
+    # (12 s when the search ran first), 2026-11-25
+    assert time.perf_counter() - t0 < 10.0
 
 
 @pytest.mark.parametrize("kwargs", [dict(u_max=-1.0), dict(z_max=0.0),
