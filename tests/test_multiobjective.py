@@ -203,3 +203,63 @@ def test_bad_input_is_typed():
         msyn(control.ss(A, bad.B, bad.C, bad.D), 1, 1, HinfBound())
     with pytest.raises(ValueError):  # DiscreteTimeError is a ValueError
         msyn(control.ss(bad.A, bad.B, bad.C, bad.D, 0.1), 1, 1, HinfBound())
+
+
+# ------------------------------------------------- each constraint: active, infeasible
+
+
+def test_h2_and_hinf_bounds_are_active_and_infeasible_below_their_optima():
+    """Plant of the test above: its H2 optimum on row 2 is 57.08 (measured 2026-11-25,
+    and ``free.objective`` here); an H2 bound tightening towards it raises the H∞ level
+    of rows 0-1, below it nothing is feasible.  An H∞ bound at half of rows 0-1's own
+    optimum (their H∞ objective alone) is infeasible too."""
+    P = random_plant(5, 3, 1, 3, 2, rng=np.random.default_rng(4), d11=False)
+    inf_ch, h2_ch = Channel(outputs=(0, 1)), Channel(outputs=(2,))
+    free = msyn(P, P.ny, P.nu, H2Bound(h2_ch))
+    hinf = msyn(P, P.ny, P.nu, HinfBound(inf_ch))
+    nu_hinf = h2_norm(*rows(hinf.CL, [2])) if np.all(np.asarray(hinf.CL.D)[2] == 0) else np.inf
+    levels = []
+    for bound in (1.3 * free.objective, 1.1 * free.objective):
+        assert bound < nu_hinf  # the H∞-optimal controller violates it: the bound acts
+        K, CL, gamma, info = msyn(P, P.ny, P.nu, HinfBound(inf_ch), [H2Bound(h2_ch, bound)])
+        assert h2_norm(*rows(CL, [2])) <= bound * (1 + 5e-3)
+        levels.append(gamma)
+    assert hinf.objective < levels[0] < levels[1]
+    with pytest.raises(InfeasibleError, match="H2"):
+        msyn(P, P.ny, P.nu, HinfBound(inf_ch), [H2Bound(h2_ch, 0.5 * free.objective)])
+    with pytest.raises(InfeasibleError, match="H∞"):
+        msyn(P, P.ny, P.nu, H2Bound(h2_ch), [HinfBound(inf_ch, 0.5 * hinf.objective)])
+
+
+def _fixed_mode_plant(a, b):
+    """A mode ``-a ± j b`` reachable from ``w`` only (no controller moves it) beside an
+    unstable one the controller must stabilise."""
+    return GeneralizedPlant.from_matrices(
+        A=[[-a, b, 0.0], [-b, -a, 0.0], [0.0, 0.0, 1.0]], B1=[[1.0], [0.0], [1.0]],
+        B2=[[0.0], [0.0], [1.0]], C1=[[1.0, 0.0, 1.0], [0.0, 0.0, 0.0]],
+        C2=[[0.0, 0.0, 1.0]], D12=[[0.0], [1.0]], D21=[[1.0]])
+
+
+def test_disk_and_sector_are_active_and_infeasible_around_a_fixed_mode():
+    P = load("HE1")
+    levels = []
+    for radius in (40.0, 10.0, 4.0):
+        K, CL, gamma, info = msyn(P, P.ny, P.nu, HinfBound(), [Disk(radius=radius)])
+        assert np.max(np.abs(np.linalg.eigvals(np.asarray(CL.A)))) < radius
+        levels.append(gamma)
+    assert levels[0] <= levels[1] * (1 + 1e-3) and levels[1] < levels[2]
+    levels = []
+    for theta in (np.pi / 3, np.pi / 4, np.pi / 6):
+        K, CL, gamma, info = msyn(P, P.ny, P.nu, HinfBound(), [Sector(theta)])
+        p = np.linalg.eigvals(np.asarray(CL.A))
+        assert np.all(np.abs(p.imag) < np.tan(theta) * -p.real)
+        levels.append(gamma)
+    assert levels[0] <= levels[1] * (1 + 1e-3) and levels[1] < levels[2]
+    # |−1 ± 2j| = 2.24 and its damping ratio 0.45 (a 63° sector) are out of any
+    # controller's reach
+    Q = _fixed_mode_plant(1.0, 2.0)
+    msyn(Q, 1, 1, HinfBound(), [Disk(radius=3.0), Sector(np.pi * 0.4)])
+    with pytest.raises(InfeasibleError, match="disk"):
+        msyn(Q, 1, 1, HinfBound(), [Disk(radius=2.0)])
+    with pytest.raises(InfeasibleError, match="sector"):
+        msyn(Q, 1, 1, HinfBound(), [Sector(np.pi / 4)])
