@@ -115,8 +115,10 @@ def test_an_infimum_that_is_not_attained_is_certified_and_says_so():
     assert np.all(np.linalg.eigvals(A).real < 0)
     assert gamma == pytest.approx(hinfnorm(control.ss(A, B, C, 0))[0], rel=1e-6)
     assert gamma <= info.certificates[0].lmi_level * (1 + 5e-3)
-    if gamma > info.objective_lmi * 1.01:
-        assert any("may not be attained" in w for w in info.warnings)
+    # near the infimum, or far above it and saying so (0.1115 against 0.0519, measured
+    # 2026-11-25 under every kernel)
+    assert gamma <= info.objective_lmi * 1.01 or any("may not be attained" in w
+                                                     for w in info.warnings)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
