@@ -712,7 +712,8 @@ def scaled_plant(P, nmeas: int, ncon: int, dfit: DScaleFit, block_sizes,
         raise DimensionError("block_sizes must be a sequence of (rows, cols) pairs") from exc
     if len(sizes) != dfit.nblocks:
         raise DimensionError(f"{len(sizes)} block sizes given for {dfit.nblocks} fitted blocks")
-    if any(r < 1 or c < 1 for r, c in sizes):
+    if any(r < 0 or c < 0 or r + c == 0 for r, c in sizes):
+        # (one side may be empty: musyn's channels of constraints alone, scaled by 1)
         raise DimensionError("block sizes must be positive")
     if sum(c for _, c in sizes) != nz or sum(r for r, _ in sizes) != nw:
         raise DimensionError(

@@ -26,7 +26,8 @@ from typing import Callable, NamedTuple
 import control
 import numpy as np
 
-from ..errors import DimensionError, InfeasibleError, LmiSuspensionError, ParameterError
+from ..errors import (DimensionError, InfeasibleError, LmiSuspensionError, ParameterError,
+                      SolverError)
 from ..lti.checks import as_finite_array
 from ..lti.norms import freqresp, hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
@@ -196,6 +197,9 @@ class MusynIteration:
         ``"dk"`` for a D-K iteration, ``"dscale_search"`` for the direct search after
         the loop (``seconds_k`` is then its wall time, K-steps and scaled plants,
         ``seconds_fit`` zero and ``gamma_prev`` its γ at the starting scalings).
+    certificates : tuple of SpecificationCertificate
+        With ``constraints``: each constraint recomputed on ``F_l(P, K)`` (the plant as
+        given, not the scaled one) for this iteration's controller.
     """
 
     index: int
@@ -212,6 +216,7 @@ class MusynIteration:
     gamma_prev: float = float("nan")
     K: control.StateSpace | None = field(default=None, repr=False, compare=False)
     stage: str = "dk"
+    certificates: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -243,6 +248,9 @@ class MusynResult:
         Total wall time.
     omega : numpy.ndarray
         The design grid, rad/s.
+    certificates : tuple of SpecificationCertificate
+        With ``constraints``: each constraint recomputed on ``F_l(P, K)`` for the
+        returned controller (every one met).
     """
 
     K: control.StateSpace
@@ -257,6 +265,7 @@ class MusynResult:
     reduced_from: int | None = None
     seconds: float = 0.0
     omega: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    certificates: tuple = ()
 
     def __iter__(self):
         return iter((self.K, self.CL, self.mu_peak, self))
@@ -415,7 +424,8 @@ def _dense_grid(omega: np.ndarray, n: int, peak: float, CL) -> np.ndarray:
 
 def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | None = None,
           callback: Callable[[MusynIteration], None] | None = None,
-          rng: np.random.Generator | None = None) -> MusynResult:
+          rng: np.random.Generator | None = None, constraints=(),
+          lyapunov_scales=None) -> MusynResult:
     """µ-synthesis by D-K iteration.
 
     Parameters
@@ -437,17 +447,38 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
         Called with each :class:`MusynIteration` as soon as it is complete (progress).
     rng : numpy.random.Generator, optional
         Seeds the µ lower-bound restarts (default ``np.random.default_rng(0)``).
+    constraints : sequence of Specification, optional
+        Requirements every K-step meets besides the scaled H∞ level, as in
+        :func:`~lmi_suspension.synthesis.msyn` (generalized-H2 peak bounds, H2 and H∞
+        bounds, pole regions, one's own): each K-step is then that multi-objective LMI
+        synthesis on the scaled plant (``method="lmi"``).  Their channels index ``P``'s
+        ``w`` and ``z``; inputs and outputs beyond those ``blk`` covers (after them, in
+        front of ``u`` and ``y``) are seen by the constraints only, not by µ -- the
+        channels of hard time-domain bounds.  D-K scales only the channels of ``blk``
+        and normalises the last full block to ``d = 1``, so a constraint on the
+        performance channels or on those extra ones refers to the nominal closed loop.
+        Every iterate is certified on each constraint on ``F_l(P, K)`` itself; the best
+        iterate that meets them all is returned.
+    lyapunov_scales : sequence of float, optional
+        With ``constraints``: :func:`~lmi_suspension.synthesis.msyn`'s Lyapunov scales
+        for the first K-step (searched when not given, about 15 minimisations); every
+        later K-step starts from the previous one's, and searches again only if they
+        fail.
 
     Returns
     -------
     MusynResult
+        ``CL`` is the ``w -> z`` part that ``blk`` covers.
 
     Raises
     ------
     DimensionError
         If ``blk`` does not fit the ``w``/``z`` partition of ``P``.
     InfeasibleError
-        If the first K-step finds no stabilising controller.
+        If the first K-step finds no stabilising controller, or no controller meets the
+        constraints.
+    ParameterError
+        If constraints are given with a K-step method other than ``"lmi"``.
     """
     # hinfsyn with the Riccati search heuristics of the K-steps (probes, brackets)
     from ..synthesis.hinfsyn import _hinfsyn as hinfsyn
@@ -458,10 +489,23 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     rng = rng if rng is not None else np.random.default_rng(0)
     G = GeneralizedPlant.from_statespace(P, nmeas, ncon)
     struct = BlockStructure.coerce(blk)
-    if struct.shape_M != (G.nz, G.nw):
+    constraints = tuple(constraints)
+    nz_mu, nw_mu = struct.shape_M
+    if constraints:
+        fits = nz_mu <= G.nz and nw_mu <= G.nw
+        if opts.method != "lmi":
+            raise ParameterError("constraints ride in the LMI K-step: they need "
+                                 f"method='lmi', got {opts.method!r}")
+    else:
+        fits = (nz_mu, nw_mu) == (G.nz, G.nw)
+    if not fits:
         raise DimensionError(
-            f"block structure needs F_l(P, K) of size {struct.shape_M[0]}x{struct.shape_M[1]} "
+            f"block structure needs F_l(P, K) of size {nz_mu}x{nw_mu} "
             f"(Σc x Σr); the plant's w -> z part is {G.nz}x{G.nw}")
+    free = (G.nw - nw_mu, G.nz - nz_mu)  # channels of the constraints alone
+    if lyapunov_scales is not None and len(tuple(lyapunov_scales)) != len(constraints):
+        raise ParameterError(f"lyapunov_scales must hold one scale per constraint "
+                             f"({len(constraints)}), got {lyapunov_scales!r}")
     dk_struct = _complexified(struct)
     omega = default_omega(G) if omega is None else as_finite_array(omega, "omega").ravel()
     if omega.size < 3 or np.any(omega <= 0) or np.any(np.diff(omega) <= 0):
@@ -475,6 +519,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     K_prev = None
     relax = _OverRelaxation(float(opts.dscale_overrelax))
     gamma_next = None  # K_prev's norm on the next scaled plant, when the D-step has it
+    scales = lyapunov_scales  # the constrained K-step's, searched once, then reused
     for it in range(1, int(opts.max_iter) + 1):
         t0 = time.perf_counter()
         # what the previous controller achieves on the new scaled plant (computed by the
@@ -482,11 +527,16 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
         if gamma_next is not None:
             gamma_prev = gamma_next
         else:
-            gamma_prev = (float(hinfnorm(lft(PD, K_prev, nmeas, ncon))[0])
+            gamma_prev = (float(hinfnorm(_mu_part(lft(PD, K_prev, nmeas, ncon), struct))[0])
                           if K_prev is not None else float("nan"))
         gamma_next = None
         try:
-            syn = _k_step(hinfsyn, PD, nmeas, ncon, opts, gamma_prev)
+            if constraints:
+                syn = _constrained_k_step(PD, nmeas, ncon, opts, struct, constraints,
+                                          scales)
+                scales = syn.lyapunov_scales
+            else:
+                syn = _k_step(hinfsyn, PD, nmeas, ncon, opts, gamma_prev)
         except LmiSuspensionError as exc:
             if best is None:
                 raise
@@ -495,7 +545,9 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
             break
         K = syn.K
         t1 = time.perf_counter()
-        CL = lft(G, K)
+        CL_full = lft(G, K)
+        CL = _mu_part(CL_full, struct)
+        certs = _certificates(constraints, CL_full)
         if not np.all(np.real(CL.poles()) < 0):
             if best is None:
                 raise InfeasibleError("the first K-step did not give a stabilising controller")
@@ -509,13 +561,19 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
         mu_peak = float(upper[k_peak])
 
         improved = best is None or mu_peak < best[0] * (1 - opts.min_improvement)
-        if best is None or mu_peak < best[0]:
+        if (best is None or mu_peak < best[0]) and all(c.met for c in certs):
             best = (mu_peak, K, it)
             best_dstep = (mu.d_blocks, upper)
+        elif best is None:
+            raise InfeasibleError("the first K-step's controller violates " + "; ".join(
+                f"{c.name} ({c.achieved:.6g})" for c in certs if not c.met))
         since_best = 0 if improved else since_best + 1
 
         done = None
+        # (a constrained K-step's common Lyapunov matrix may well not reach the previous
+        # controller's level: not a loss of accuracy)
         regressed = (opts.stop_on_kstep_regression and np.isfinite(gamma_prev)
+                     and not constraints
                      and syn.gamma > gamma_prev * (1 + _KSTEP_RTOL)
                      # over-relaxed scalings can give a plant the K-step handles badly;
                      # the next D-step then restarts from the best iterate instead
@@ -546,7 +604,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
                                   rtol=opts.dfit_rtol, weights=weights,
                                   mu_check=lambda fits: _scaled_peak(fits, M_s, omega, dk_struct),
                                   mu_peak=peak_s)
-                return fit, scaled_plant(G.sys, nmeas, ncon, fit, _block_sizes(dk_struct))
+                return fit, _scaled(G.sys, nmeas, ncon, fit, dk_struct, free)
 
             try:
                 dfit, PD_next = scaled(d_target)
@@ -555,7 +613,8 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
                     # beyond the grid points; the controller's norm on the new scaled
                     # plant can (an extrapolated fit on a coarse grid gave 1739 there
                     # against 1.04 on the grid, measured)
-                    gamma_next = float(hinfnorm(lft(PD_next, K_ref, nmeas, ncon))[0])
+                    gamma_next = float(hinfnorm(_mu_part(lft(PD_next, K_ref, nmeas, ncon),
+                                                         struct))[0])
                     if not gamma_next <= dfit.mu_value * (1 + _OFFGRID_RTOL):
                         logger.info("musyn: over-relaxed D-fit peaks off the grid (%.4g "
                                     "against %.4g); plain D-step instead", gamma_next,
@@ -575,7 +634,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
             mu_lower_peak=lower_peak, peak_omega=float(omega[k_peak]),
             dfit_orders=orders, controller_order=K.nstates, seconds_k=t1 - t0,
             seconds_d=t2 - t1, seconds_fit=t4 - t3, warnings=tuple(syn.warnings),
-            gamma_prev=gamma_prev, K=K)
+            gamma_prev=gamma_prev, K=K, certificates=certs)
         history.append(record)
         K_prev = K_ref
         logger.info("musyn iteration %d: gamma=%.4f (previous K %.4f) mu=%.4f (lower %.4f) "
@@ -589,7 +648,9 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
             stop_reason = done
             break
 
-    if opts.dscale_search and best[0] >= opts.mu_target:
+    if opts.dscale_search and best[0] >= opts.mu_target and constraints:
+        logger.info("musyn: no D-scale search with constraints (its K-step is Riccati's)")
+    elif opts.dscale_search and best[0] >= opts.mu_target:
         found = _search_stage(G, nmeas, ncon, dk_struct, omega, best_dstep, opts, rng,
                               index=len(history) + 1, hinfsyn=hinfsyn)
         if found is not None:
@@ -601,15 +662,16 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
                 stop_reason += f"; D-scale search to µ {found.mu_peak:.4f}"
 
     mu_best, K, best_it = best
-    CL = balanced_statespace(lft(G, K))
+    CL = balanced_statespace(_mu_part(lft(G, K), struct))
     dense = _dense_grid(omega, int(opts.n_dense), history[best_it - 1].peak_omega, CL)
     final, _ = _mu_bounds(CL, struct, dense, rng)
     reduced_from = None
     if opts.reduce_order is not None and int(opts.reduce_order) < K.nstates:
         K_red = _try_reduce(K, int(opts.reduce_order))
         if K_red is not None:
-            CL_red = balanced_statespace(lft(G, K_red))
-            if np.all(np.real(CL_red.poles()) < 0):
+            CL_red = balanced_statespace(_mu_part(lft(G, K_red), struct))
+            if np.all(np.real(CL_red.poles()) < 0) and all(
+                    c.met for c in _certificates(constraints, lft(G, K_red))):
                 final_red, _ = _mu_bounds(CL_red, struct, dense, rng)
                 if np.max(final_red.upper) <= np.max(final.upper) * (1 + opts.reduce_mu_tol):
                     reduced_from = K.nstates
@@ -623,7 +685,71 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
         K=K, CL=CL, mu_peak=float(upper[k_peak]), mu_lower_peak=float(np.max(final.lower)),
         peak_omega=float(dense[k_peak]), mu=final, history=tuple(history),
         best_iteration=best_it, stop_reason=stop_reason, reduced_from=reduced_from,
-        seconds=time.perf_counter() - t_start, omega=omega)
+        seconds=time.perf_counter() - t_start, omega=omega,
+        certificates=_certificates(constraints, lft(G, K)))
+
+
+def _mu_part(CL: control.StateSpace, struct: BlockStructure) -> control.StateSpace:
+    """The ``w -> z`` part of a closed loop that ``struct`` covers (its first rows and
+    columns); the closed loop itself when there are no constraint channels."""
+    nz, nw = struct.shape_M
+    if (CL.noutputs, CL.ninputs) == (nz, nw):
+        return CL
+    return control.ss(CL.A, np.asarray(CL.B)[:, :nw], np.asarray(CL.C)[:nz],
+                      np.asarray(CL.D)[:nz, :nw])
+
+
+def _certificates(constraints, CL_full) -> tuple:
+    """Each constraint recomputed on the unscaled closed loop, independently of the
+    K-step's own certificates (which are on the scaled plant)."""
+    from ..synthesis.multiobjective import _certify
+
+    return tuple(_certify(c, CL_full, c.bound, c.bound) for c in constraints)
+
+
+def _scaled(G, nmeas, ncon, fit, struct, free):
+    """The D-scaled plant; the constraint channels (``free`` inputs and outputs beyond
+    ``blk``) pass unscaled."""
+    from .dfit import scaled_plant
+
+    sizes = _block_sizes(struct)
+    if any(free):
+        unit = control.ss([], [], [], [[1.0]])
+        fit = replace(fit, fits=tuple(fit.fits) + (unit,), orders=tuple(fit.orders) + ((0,),),
+                      errors=tuple(fit.errors) + (0.0,))
+        sizes = sizes + [free]
+    return scaled_plant(G, nmeas, ncon, fit, sizes)
+
+
+def _constrained_k_step(PD, nmeas, ncon, opts, struct, constraints, scales):
+    """The multi-objective LMI K-step: the scaled µ channels' H∞ norm minimised subject
+    to ``constraints``.  The Lyapunov scales are searched on the first K-step and reused
+    after (the search costs ~15 minimisations), searched again if they fail."""
+    from ..synthesis.constraints import Channel, HinfBound
+    from ..synthesis.multiobjective import msyn
+
+    nz, nw = struct.shape_M
+    objective = HinfBound(Channel(outputs=tuple(range(nz)), inputs=tuple(range(nw))),
+                          name="scaled µ channels")
+    if scales is not None:
+        try:
+            return _KStep(msyn(PD, nmeas, ncon, objective, constraints,
+                               options=opts.hinfsyn_options, lyapunov_scales=scales))
+        except (InfeasibleError, SolverError) as exc:
+            logger.info("musyn: constrained K-step with the previous Lyapunov scales "
+                        "failed (%s); searching them again", exc)
+    return _KStep(msyn(PD, nmeas, ncon, objective, constraints,
+                       options=opts.hinfsyn_options))
+
+
+class _KStep:
+    """A constrained K-step's result in the shape the loop reads (``K``, ``gamma``,
+    ``warnings``)."""
+
+    def __init__(self, res):
+        self.K, self.gamma = res.K, res.objective
+        self.warnings = res.warnings
+        self.lyapunov_scales = res.lyapunov_scales
 
 
 def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hinfsyn):

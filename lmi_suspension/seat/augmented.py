@@ -364,7 +364,8 @@ def _core(params: SeatParameters, opts: SeatDesignOptions):
 
 
 def seat_augmented_plant(options: SeatDesignOptions | None = None,
-                         params: SeatParameters | None = None) -> SeatAugmentedPlant:
+                         params: SeatParameters | None = None, *,
+                         peak_channels: bool = False) -> SeatAugmentedPlant:
     """Build the augmented seat plant of Fig. 2 for ``musyn``/``mussv``.
 
     Parameters
@@ -373,6 +374,12 @@ def seat_augmented_plant(options: SeatDesignOptions | None = None,
         Weights and uncertainty choices (defaults: all three uncertainties on).
     params : SeatParameters, optional
         Physical parameters (Table 1 by default).
+    peak_channels : bool
+        Also give the plant the channels of hard time-domain bounds, which µ does not
+        see (they lie beyond ``blk``, see :func:`~lmi_suspension.mu.musyn`'s
+        ``constraints``): the input ``'road'``, a floor velocity in m/s added to the
+        shaped one, and the outputs ``'u_cmd'`` (the commanded force, N) and ``'x1_m'``
+        (the stroke, m), after the performance channels.
 
     Returns
     -------
@@ -402,8 +409,8 @@ def seat_augmented_plant(options: SeatDesignOptions | None = None,
     core, nominal, names, rows, p_par, q_par, p_nb, q_nb = _core(params, opts)
 
     systems = [core,
-               control.ss(disturbance_weight(opts), inputs=["w"], outputs=["zdot0"],
-                          name="w_scale"),
+               control.ss(disturbance_weight(opts), inputs=["w"],
+                          outputs=["zdot0_w" if peak_channels else "zdot0"], name="w_scale"),
                control.ss(wk_weight(opts.wk_order, acc_ref=opts.acc_ref),
                           inputs=["z3dd"], outputs=["e_acc"], name="W_acc"),
                _static(1.0 / z_max, ["x1"], ["e_defl"], "W_defl"),
@@ -442,8 +449,14 @@ def seat_augmented_plant(options: SeatDesignOptions | None = None,
 
     names.append("performance")
     rows.append([3, 3])
-    inplist = p_delay + p_par + p_nb + ["w", "n1", "n2", "u"]
-    outlist = q_delay + q_par + q_nb + ["e_acc", "e_force", "e_defl", "y1", "y2"]
+    extra_in, extra_out = [], []
+    if peak_channels:
+        systems += [control.summing_junction(["zdot0_w", "road"], "zdot0", name="sum_road"),
+                    _static(1.0, ["u"], ["u_cmd"], "u_cmd"),
+                    _static(1.0, ["x1"], ["x1_m"], "x1_m")]
+        extra_in, extra_out = ["road"], ["u_cmd", "x1_m"]
+    inplist = p_delay + p_par + p_nb + ["w", "n1", "n2"] + extra_in + ["u"]
+    outlist = q_delay + q_par + q_nb + ["e_acc", "e_force", "e_defl"] + extra_out + ["y1", "y2"]
     P = control.interconnect(systems, inplist=inplist, outlist=outlist,
                              inputs=inplist, outputs=outlist, name="P_seat")
     P = control.ss(P.A, P.B, P.C, P.D, inputs=inplist, outputs=outlist, name="P_seat")

@@ -413,8 +413,12 @@ class Disk:
 
     def lmis(self, v, level, slack) -> list:
         A, Xc = v.calA, v.calX
-        M = _sym(cp.bmat([[-self.radius * Xc, self.center * Xc + A],
-                          [self.center * Xc + A.T, -self.radius * Xc]]))
+        # divided by the radius (a positive factor: the same LMI), so that its entries
+        # are of the size of calX whatever the radius (1000 rad/s on the seat put them
+        # 1e7 above the H∞ level's, and every Clarabel solve needed a recovery)
+        c = self.center / self.radius
+        M = _sym(cp.bmat([[-Xc, c * Xc + A / self.radius],
+                          [c * Xc + A.T / self.radius, -Xc]]))
         return [M << -slack * np.eye(M.shape[0])]
 
     def certify(self, CL) -> float:

@@ -312,9 +312,9 @@ def _synthesise(G: GeneralizedPlant, objective, constraints, options, lyapunov_s
         clean = recoveries == 0 and status in _lmi._OK
         return float(level.value), frame.T @ Yb @ frame.T.T, Ti.T @ Xb @ Ti, clean
 
-    def raise_if_infeasible(only=None):
-        """InfeasibleError if the constraints alone (or constraint ``only`` alone) have no
-        strictly feasible point."""
+    def largest_margin(only=None):
+        """The largest common margin of the constraints alone (or of constraint ``only``
+        alone), None when Clarabel fails."""
         t = cp.Variable()
         v = form.variables(Ps, None)
         cons = build(v, None, _SLACK_WEIGHT * t, t, with_objective=False, only=only)
@@ -325,9 +325,31 @@ def _synthesise(G: GeneralizedPlant, objective, constraints, options, lyapunov_s
         except SolverError:
             status = None
         logger.info("msyn: constraints alone: status %s, margin %s", status, t.value)
-        if status in _lmi._INFEASIBLE or (t.value is not None and t.value <= _FEASIBLE_MARGIN):
-            raise InfeasibleError(_infeasible_message(specs) + f" (largest common margin of "
-                                  f"the constraints alone: {t.value})")
+        if status in _lmi._INFEASIBLE:
+            return -np.inf
+        return None if t.value is None or status not in _lmi._OK else float(t.value)
+
+    def raise_if_infeasible(only=None):
+        """InfeasibleError if the constraints alone (or constraint ``only`` alone) have no
+        strictly feasible point."""
+        tried = [largest_margin(only)]
+        if only is not None and _scalable(specs[only - 1]) and not (tried[-1] or 0.0) > _FEASIBLE_MARGIN:
+            # a constraint alone is met by the same controllers at every Lyapunov scale,
+            # but the margin is not: on the seat's µ plant the stroke's peak bound (met
+            # by the passive seat with 20 % to spare) had margin -1.5e-3 at scale 1 and
+            # 0.42 at 1e5 (2026-11-25); so other scales are asked before "infeasible"
+            kept = alpha[only]
+            for a in _alone_scales(scaled_spec(only, specs[only - 1]), factor[only]):
+                alpha[only] = a
+                tried.append(largest_margin(only))
+                if tried[-1] is not None and tried[-1] > _FEASIBLE_MARGIN:
+                    break
+            alpha[only] = kept
+        best = max((m for m in tried if m is not None), default=None)
+        if best is None or best > _FEASIBLE_MARGIN:
+            return  # feasible, or Clarabel could not tell (the caller goes on)
+        raise InfeasibleError(_infeasible_message(specs) + f" (largest common margin of "
+                              f"the constraints alone: {best:.3g})")
 
     warnings: list[str] = []
     identity = _lmi.Frame.identity(n)
@@ -516,6 +538,23 @@ def _infeasible_message(specs) -> str:
     names = ", ".join(f"{s.name}{asked(s)}" for s in specs)
     return (f"no controller meets the constraints ({names or 'none'}) with a common "
             "Lyapunov matrix")
+
+
+#: decades (relative to the level's own scale) at which a constraint alone is asked
+#: before it counts as infeasible (see raise_if_infeasible)
+_ALONE_DECADES = (0.0, -2.0, 2.0, -4.0, 4.0)
+
+
+def _alone_scales(spec, factor: float) -> list:
+    """Lyapunov scales at which a norm constraint alone is asked: around the one that
+    makes its scaled level of order one (``1/b²`` for a peak bound ``b``, ``1/level``
+    otherwise), whatever the balanced plant's units."""
+    if isinstance(spec, PeakBound):
+        centre = 1.0 / min(spec.bounds) ** 2
+    else:
+        x = spec.bound * factor
+        centre = 1.0 / (x**2 if _level_of(spec) == "squared" else x)
+    return [centre * 10.0**d for d in _ALONE_DECADES]
 
 
 def _given_scales(scales, specs) -> list:
