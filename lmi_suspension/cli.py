@@ -1,4 +1,5 @@
-"""Command line: ``lmi-suspension model | reproduce | simulate | sweep | export``."""
+"""Command line: ``lmi-suspension model | reproduce | simulate | sweep | design-constrained |
+export``."""
 
 from __future__ import annotations
 
@@ -116,7 +117,28 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         raise InputError(f"{path} is not a saved controller ({type(exc).__name__}: {exc})") \
             from exc
     road = _road(args.road, args.seed, args.duration)
-    res = simulate(K, road, delay=args.delay)
+    if args.discrete:
+        import numpy as np
+
+        from .io import load_discrete_controller
+        from .seat.sampled import simulate_sampled
+
+        Kd, _ = load_discrete_controller(path)
+        noise = None
+        if args.noise is not None:
+            noise = tuple(float(v) for v in args.noise.split(","))
+            if len(noise) != 2:
+                raise ParameterError(f"--noise takes two standard deviations (m), x1,x3; "
+                                     f"got {args.noise!r}")
+        res = simulate_sampled(Kd, road, delay=args.delay, noise=noise,
+                               quantisation=args.quantisation,
+                               rng=np.random.default_rng(args.seed))
+        realization = f"discrete, {1 / Kd.dt:g} Hz, zero-order hold"
+    else:
+        if args.noise is not None or args.quantisation is not None:
+            raise ParameterError("--noise and --quantisation apply to --discrete runs")
+        res = simulate(K, road, delay=args.delay)
+        realization = "continuous"
     m = res.metrics()
     linear = closed_loop_stable(K, args.delay)
     if args.plot:
@@ -126,18 +148,21 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
                              title=road.description)
         fig.savefig(args.plot, dpi=110)
     if args.json:
-        data = {"controller": str(path), "road": road.description, "delay": args.delay,
-                "seed": args.seed, "stable_linear": linear, **dataclasses.asdict(m)}
+        data = {"controller": str(path), "realization": realization,
+                "road": road.description, "delay": args.delay,
+                "seed": args.seed, "stable_linear": linear,
+                "peak_u_command": float(abs(res.u_command).max()), **dataclasses.asdict(m)}
         data = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
                 for k, v in data.items()}
         sys.stdout.write(json.dumps(data, indent=1) + "\n")
         return 0
     out = sys.stdout
-    out.write(f"controller {path} ({K.nstates} states), road: {road.description}, "
-              f"delay {args.delay * 1e3:g} ms\n")
+    out.write(f"controller {path} ({K.nstates} states, {realization}), road: "
+              f"{road.description}, delay {args.delay * 1e3:g} ms\n")
     rows = [("peak |z3''|", m.peak_z3dd, "m/s^2"), ("RMS z3''", m.rms_z3dd, "m/s^2"),
             ("Wk-weighted RMS z3''", m.weighted_rms_z3dd, "m/s^2"),
             ("VDV", m.vdv_z3dd, "m/s^1.75"), ("peak |x1|", m.peak_x1, "m"),
+            ("peak |u| commanded", float(abs(res.u_command).max()), "N"),
             ("peak |u| applied", m.peak_u, "N"), ("time in saturation", m.saturation_time, "s")]
     for label, value, unit in rows:
         out.write(f"  {label:<22} {value:12.5g} {unit}\n")
@@ -145,6 +170,27 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
               f"(z_max = {m.z_max} m)\n")
     out.write(f"  {'stable (simulation)':<22} {'yes' if m.stable else 'NO':>12}\n")
     out.write(f"  {'stable (Nyquist)':<22} {'yes' if linear else 'NO':>12}\n")
+    return 0
+
+
+def _cmd_design_constrained(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .seat.constrained import SHIPPED_CONTROLLER, design_constrained_mu, save_constrained
+
+    def on_iteration(rec):
+        sys.stderr.write(f"D-K iteration {rec.index}: gamma {rec.gamma:.4f}, µ upper "
+                         f"{rec.mu_peak:.4f} ({rec.seconds_k:.0f} s K-step)\n")
+
+    d = design_constrained_mu(args.u_bound, args.z_bound, disk_radius=args.disk_radius,
+                              callback=on_iteration)
+    out = Path(args.out) if args.out else SHIPPED_CONTROLLER
+    save_constrained(out, d)
+    sys.stdout.write(
+        f"µ upper {d.mu_peak:.4f}, lower {d.mu_lower_peak:.4f}; worst case for the bump's "
+        f"energy: |u| {d.u_peak:.0f} N (bound {d.u_bound:g}), |x1| {d.x1_peak:.4f} m "
+        f"(bound {d.z_bound:g}); fastest pole {d.fastest_pole:.0f} rad/s; "
+        f"{d.seconds:.0f} s; written to {out}\n")
     return 0
 
 
@@ -295,6 +341,14 @@ def build_parser() -> argparse.ArgumentParser:
                        help="length of the road record in seconds (bump 3, noise/iso-C 5)")
     p_sim.add_argument("--plot", default=None, help="write the z3'' response to this PNG")
     p_sim.add_argument("--json", action="store_true", help="print the metrics as JSON")
+    p_sim.add_argument("--discrete", action="store_true",
+                       help="run the file's discrete realization (Ad, Bd, Cd, Dd, dt) in the "
+                            "sampled-data loop: zero-order hold, exact delay, clipping")
+    p_sim.add_argument("--noise", default=None,
+                       help="with --discrete: sensor-noise standard deviations x1,x3 in m "
+                            "(seeded by --seed)")
+    p_sim.add_argument("--quantisation", type=float, default=None,
+                       help="with --discrete: sensor resolution in m")
     p_sim.set_defaults(func=_cmd_simulate)
 
     p_sw = sub.add_parser(
@@ -328,6 +382,19 @@ def build_parser() -> argparse.ArgumentParser:
                       help="worker processes of the local cluster (default 2; 0: no Dask)")
     p_sw.add_argument("-q", "--quiet", action="store_true", help="no progress bar")
     p_sw.set_defaults(func=_cmd_sweep)
+
+    p_dc = sub.add_parser("design-constrained",
+                          help="µ-synthesis with hard force/stroke bounds and a pole disk in "
+                               "every K-step (minutes); writes the controller file "
+                               "reproduce loads")
+    p_dc.add_argument("--u-bound", type=float, default=4000.0,
+                      help="|u| bound, N, for every floor velocity of the bump's energy")
+    p_dc.add_argument("--z-bound", type=float, default=0.16, help="|x1| bound, m, likewise")
+    p_dc.add_argument("--disk-radius", type=float, default=2000.0,
+                      help="closed-loop poles in |s| < this, rad/s")
+    p_dc.add_argument("--out", default=None,
+                      help="controller file to write (default: the one shipped in the package)")
+    p_dc.set_defaults(func=_cmd_design_constrained)
 
     p_ex = sub.add_parser("export", help="write a saved controller as a MATLAB .mat file "
                           "(A, B, C, D, InputName, OutputName; Ts when discretised) or JSON")

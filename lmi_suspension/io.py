@@ -1,7 +1,9 @@
 """Saving and loading controllers as JSON, exactly, and exporting them as MATLAB files.
 
 A saved controller is a continuous-time state-space system with keys ``A``, ``B``, ``C``,
-``D`` (lists of rows), ``inputs``, ``outputs`` and free-form ``metadata``. Python's ``json``
+``D`` (lists of rows), ``inputs``, ``outputs`` and free-form ``metadata``; a controller
+meant for a computer also carries its discrete realization, ``Ad``, ``Bd``, ``Cd``, ``Dd``
+and the sample time ``dt`` (s). Python's ``json``
 writes floats with the shortest repr that round-trips, so loading gives back the same
 IEEE-754 numbers bit for bit.
 """
@@ -18,7 +20,8 @@ from .errors import DimensionError, InputError
 from .lti.checks import as_finite_array, as_statespace
 
 __all__ = ["controller_to_dict", "controller_from_dict", "save_controller", "load_controller",
-           "save_controller_mat", "load_controller_mat"]
+           "discrete_from_dict", "load_discrete_controller", "save_controller_mat",
+           "load_controller_mat"]
 
 FORMAT = "lmi_suspension.controller/1"
 
@@ -27,8 +30,9 @@ def _rows(M: np.ndarray) -> list[list[float]]:
     return [[float(v) for v in row] for row in np.asarray(M, dtype=float)]
 
 
-def controller_to_dict(K, *, inputs=None, outputs=None, metadata=None) -> dict:
-    """Describe a continuous-time controller as a JSON-ready dict.
+def controller_to_dict(K, *, inputs=None, outputs=None, metadata=None, discrete=None) -> dict:
+    """Describe a continuous-time controller as a JSON-ready dict (with ``discrete``, a
+    discrete-time realization of it, also ``Ad``, ``Bd``, ``Cd``, ``Dd`` and ``dt``).
 
     Examples
     --------
@@ -48,7 +52,7 @@ def controller_to_dict(K, *, inputs=None, outputs=None, metadata=None) -> dict:
             f"controller has {K.ninputs} inputs and {K.noutputs} outputs; names given for "
             f"{len(inputs)} and {len(outputs)}")
     n = K.nstates
-    return {
+    data = {
         "format": FORMAT,
         "A": _rows(np.reshape(K.A, (n, n))),
         "B": _rows(np.reshape(K.B, (n, K.ninputs))),
@@ -58,6 +62,22 @@ def controller_to_dict(K, *, inputs=None, outputs=None, metadata=None) -> dict:
         "outputs": outputs,
         "metadata": dict(metadata or {}),
     }
+    if discrete is not None:
+        Kd = discrete
+        if not isinstance(Kd, control.StateSpace):
+            raise InputError(f"discrete must be a control.StateSpace, got {type(Kd).__name__}")
+        dt = Kd.dt
+        if isinstance(dt, bool) or not (isinstance(dt, (int, float)) and dt > 0):
+            raise InputError(f"discrete must have a positive numeric sample time, got {dt!r}")
+        if (Kd.ninputs, Kd.noutputs) != (K.ninputs, K.noutputs):
+            raise DimensionError("the discrete realization must have the controller's "
+                                 "inputs and outputs")
+        nd = Kd.nstates
+        data.update(Ad=_rows(np.reshape(Kd.A, (nd, nd))),
+                    Bd=_rows(np.reshape(Kd.B, (nd, Kd.ninputs))),
+                    Cd=_rows(np.reshape(Kd.C, (Kd.noutputs, nd))),
+                    Dd=_rows(np.reshape(Kd.D, (Kd.noutputs, Kd.ninputs))), dt=float(dt))
+    return data
 
 
 def controller_from_dict(data: dict) -> control.StateSpace:
@@ -81,10 +101,61 @@ def controller_from_dict(data: dict) -> control.StateSpace:
     return control.ss(A, B, C, D, inputs=inputs, outputs=outputs, name="K")
 
 
-def save_controller(path, K, *, inputs=None, outputs=None, metadata=None) -> Path:
+def discrete_from_dict(data: dict) -> control.StateSpace:
+    """The discrete realization stored by :func:`controller_to_dict` (exactly).
+
+    Raises
+    ------
+    InputError
+        The description holds no discrete realization.
+
+    Examples
+    --------
+    >>> import control
+    >>> K = control.ss([[-1.0]], [[1.0, 0.5]], [[2.0]], [[0.0, 0.1]])
+    >>> d = controller_to_dict(K, discrete=control.c2d(K, 1e-3, "tustin"))
+    >>> discrete_from_dict(d).dt
+    0.001
+    """
+    if "dt" not in data:
+        raise InputError("the controller description holds no discrete realization "
+                         "(keys Ad, Bd, Cd, Dd, dt)")
+    cont = controller_from_dict(data)
+    view = {"A": data.get("Ad"), "B": data.get("Bd"), "C": data.get("Cd"),
+            "D": data.get("Dd"), "inputs": data["inputs"], "outputs": data["outputs"]}
+    if any(v is None for v in view.values()):
+        raise InputError("the discrete realization needs Ad, Bd, Cd, Dd and dt")
+    Kd = controller_from_dict(view)
+    dt = data["dt"]
+    if isinstance(dt, bool) or not (isinstance(dt, (int, float)) and dt > 0):
+        raise InputError(f"dt must be a positive number of seconds, got {dt!r}")
+    return control.ss(Kd.A, Kd.B, Kd.C, Kd.D, float(dt), inputs=cont.input_labels,
+                      outputs=cont.output_labels, name="Kd")
+
+
+def load_discrete_controller(path) -> tuple[control.StateSpace, dict]:
+    """Read the discrete realization of a controller file (see :func:`discrete_from_dict`)."""
+    data = _read(path)
+    return discrete_from_dict(data), dict(data.get("metadata", {}))
+
+
+def _read(path) -> dict:
+    path = Path(path)
+    try:
+        data = json.loads(path.read_text())
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{path} is not valid JSON: {exc}") from exc
+    if not isinstance(data, dict):
+        raise InputError(f"{path} does not hold a controller object")
+    return data
+
+
+def save_controller(path, K, *, inputs=None, outputs=None, metadata=None,
+                    discrete=None) -> Path:
     """Write ``K`` to ``path`` as JSON (see :func:`controller_to_dict`); returns the path."""
     path = Path(path)
-    data = controller_to_dict(K, inputs=inputs, outputs=outputs, metadata=metadata)
+    data = controller_to_dict(K, inputs=inputs, outputs=outputs, metadata=metadata,
+                              discrete=discrete)
 
     text = json.dumps(data, indent=1, default=_json_default, allow_nan=True)
     path.write_text(text + "\n")
@@ -101,13 +172,7 @@ def load_controller(path) -> tuple[control.StateSpace, dict]:
     metadata : dict
         The saved metadata.
     """
-    path = Path(path)
-    try:
-        data = json.loads(path.read_text())
-    except json.JSONDecodeError as exc:
-        raise InputError(f"{path} is not valid JSON: {exc}") from exc
-    if not isinstance(data, dict):
-        raise InputError(f"{path} does not hold a controller object")
+    data = _read(path)
     return controller_from_dict(data), dict(data.get("metadata", {}))
 
 

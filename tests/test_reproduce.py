@@ -17,7 +17,9 @@ from matplotlib.image import imread
 from lmi_suspension.errors import AssumptionError, ParameterError
 from lmi_suspension.io import load_controller
 from lmi_suspension.mu.dk import MusynIteration
+from lmi_suspension.seat.constrained import ConstrainedCheck
 from lmi_suspension.seat.design import MuCheck, SeatMuDesign
+from lmi_suspension.seat.sampled import discretise_controller, simulate_sampled
 from lmi_suspension.sweep import read_results
 from lmi_suspension.seat import (
     SeatDesignOptions,
@@ -33,7 +35,10 @@ EXPECTED_PNGS = {
     "fig07_bump.png", "fig08_white_noise.png", "fig09_bump_z3dd.png", "fig10_bump_x1.png",
     "fig11_bump_u_applied.png", "fig12_noise_z3dd.png", "fig13_noise_x1.png",
     "fig14_noise_u_applied.png", "fig15_mu_bounds.png", "peak_vs_delay.png", "iso_C_z3dd.png",
+    "force_commanded_vs_applied.png", "mu_bounds_constrained.png",
 }
+#: the stand-in of the shipped constrained controller: a weaker low-passed stiffness
+K_CONSTRAINED = control.ss([[-150.0]], [[150.0, 0.0]], [[4000.0]], [[0.0, 500.0]])
 
 
 def _stand_in(fail_riccati=False):
@@ -70,9 +75,23 @@ def _stand_in(fail_riccati=False):
         return (MuCheck("as designed", ("delay", "performance"), 0.7, 0.69, 12.0),
                 MuCheck("+ paper", ("delay", "nb_AB", "performance"), 0.8, 0.79, 13.0))
 
+    def load_constrained():
+        Kd = discretise_controller(K_CONSTRAINED, 1e-3)
+        return K_CONSTRAINED, Kd, {"description": "stand-in", "u_bound": 4000.0}
+
+    def certify_constrained(K, rng=None):
+        calls.append("certify")
+        return ConstrainedCheck(mu_peak=1.2, mu_lower_peak=1.1, omega=omega,
+                                mu_upper=1.2 * upper / upper.max(),
+                                mu_lower=1.1 * upper / upper.max(), u_peak=3000.0,
+                                x1_peak=0.05, energy=0.45, fastest_pole=150.0,
+                                controller_fastest_pole=150.0)
+
     api = SimpleNamespace(design_mu_controller=design_mu_controller,
                           design_nominal_hinf=design_nominal_hinf,
                           analyse_uncertainty=analyse_uncertainty,
+                          load_constrained=load_constrained,
+                          certify_constrained=certify_constrained,
                           DEFAULT_DESIGN=SeatDesignOptions(), DEFAULT_MUSYN=None)
     return api, K_mu, history, calls
 
@@ -98,8 +117,11 @@ def run(tmp_path_factory):
 @pytest.mark.slow
 def test_every_file_is_written(run):
     names = {p.name for p in run.out.iterdir()}
-    assert EXPECTED_PNGS | {"summary.json", "controller.json", "controller.mat"} <= names
-    assert {p.name for p in run.summary.files} == names
+    assert EXPECTED_PNGS | {"summary.json", "controller.json", "controller.mat",
+                            "controllers"} <= names
+    assert {p.relative_to(run.out).parts[0] for p in run.summary.files} == names
+    assert {p.name for p in (run.out / "controllers").iterdir()} == {
+        f"{n}.json" for n in R.CONTROLLER_NAMES if n != "passive"}
 
 
 @pytest.mark.slow
@@ -159,6 +181,34 @@ def test_controller_json_round_trips_exactly(run):
     assert meta["mu_peak_lower"] == run.summary.mu_lower_peak
     assert meta["design_options"]["acc_ref"] == SeatDesignOptions().acc_ref
     assert meta["version"]
+
+
+@pytest.mark.slow
+def test_every_controller_file_holds_both_realizations(run):
+    from lmi_suspension.io import load_discrete_controller
+
+    for name in ("mu", "mu_constrained"):
+        K, _ = load_controller(run.out / "controllers" / f"{name}.json")
+        Kd, meta = load_discrete_controller(run.out / "controllers" / f"{name}.json")
+        assert Kd.dt == 1e-3 and meta["fastest_pole"] > 0
+        # the discrete realization is the controller's Tustin map, recomputed here
+        ref = control.sample_system(K, 1e-3, method="bilinear")
+        assert np.allclose(np.asarray(Kd(np.exp(0.02j))), np.asarray(ref(np.exp(0.02j))))
+    K, _ = load_controller(run.out / "controllers" / "mu_constrained.json")
+    assert np.array_equal(np.asarray(K.A), np.asarray(K_CONSTRAINED.A))
+
+
+@pytest.mark.slow
+def test_constrained_row_reports_commanded_force_and_the_sampled_loop(run):
+    c = run.summary.controller("mu_constrained")
+    road = bump(t_end=R._QUICK.bump_t_end, dt=R._QUICK.road_dt)
+    direct = simulate(K_CONSTRAINED, road, delay=0.025, dt=R._QUICK.sim_dt)
+    assert c.peak_u_command[-1] == pytest.approx(np.max(np.abs(direct.u_command)), rel=1e-12)
+    sampled = simulate_sampled(discretise_controller(K_CONSTRAINED, 1e-3), road, delay=0.025)
+    assert c.sampled_peak_z3dd[-1] == pytest.approx(np.max(np.abs(sampled.z3dd)), rel=1e-12)
+    data = json.loads((run.out / "summary.json").read_text())
+    assert data["mu_constrained"]["check"]["mu_peak"] == 1.2
+    assert "certify" in run.calls
 
 
 @pytest.mark.slow

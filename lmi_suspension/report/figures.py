@@ -75,18 +75,50 @@ def plot_responses(runs: Mapping[str, object], signal: str, *, title: str = "",
         style = ({"color": "0.45", "lw": 1.6, "ls": "--"} if label.startswith("passive")
                  else {"lw": 1.2})
         ax.plot(run.t, getattr(run, signal), label=label, **style)
+    return _finish_time_axes(fig, ax, f"{name} [{unit}]", limit,
+                             f"limit ±{limit:g} {unit}" if limit is not None else "",
+                             t_max, title, fontsize=8)
+
+
+def _finish_time_axes(fig, ax, ylabel, limit, limit_label, t_max, title, *, fontsize):
+    """Symmetric limit lines, labels, grid and legend of a time-response axis."""
     if limit is not None:
         for sign in (1, -1):
             ax.axhline(sign * limit, color="r", ls=":", lw=1,
-                       label=f"limit ±{limit:g} {unit}" if sign > 0 else None)
+                       label=limit_label if sign > 0 else None)
     ax.set_xlabel("time [s]")
-    ax.set_ylabel(f"{name} [{unit}]")
+    ax.set_ylabel(ylabel)
     if t_max is not None:
         ax.set_xlim(0, t_max)
     ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, ncol=2)
+    ax.legend(fontsize=fontsize, ncol=2)
     ax.set_title(title)
     return fig
+
+
+def plot_commanded_force(runs: Mapping[str, object], *, limit: float | None = None,
+                         t_max: float | None = None, title: str = "") -> Figure:
+    """Commanded (solid) against applied (dashed) force of several simulations: where
+    they part, the actuator clips and the loop is no longer the one designed.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from lmi_suspension.seat import bump, simulate
+    >>> r = simulate(np.array([[20000.0, 0.0]]), bump(t_end=0.5), dt=1e-3)
+    >>> fig = plot_commanded_force({"K": r}, limit=1500.0)
+    >>> len(fig.axes[0].get_lines())
+    4
+    """
+    fig = Figure(figsize=(7, 3.8), layout="constrained")
+    ax = fig.subplots()
+    for k, (label, run) in enumerate(runs.items()):
+        ax.plot(run.t, run.u_command, color=f"C{k}", lw=1.2, label=f"{label}, commanded")
+        ax.plot(run.t, run.u_applied, color=f"C{k}", lw=1.0, ls="--",
+                label=f"{label}, applied")
+    return _finish_time_axes(fig, ax, "actuator force $u$ [N]", limit,
+                             f"actuator limit ±{limit:g} N" if limit is not None else "",
+                             t_max, title, fontsize=7)
 
 
 def plot_mu_bounds(omega: np.ndarray, upper: np.ndarray, lower: np.ndarray, *,

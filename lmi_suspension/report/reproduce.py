@@ -37,14 +37,18 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 #: Names of the compared controllers, in table order.
-CONTROLLER_NAMES = ("passive", "hinf_lmi_nominal", "hinf_riccati", "mu")
+CONTROLLER_NAMES = ("passive", "hinf_lmi_nominal", "hinf_riccati", "mu", "mu_constrained")
 #: the stages of :func:`reproduce`, in order: each announces itself with one progress
 #: message that does not start with a space (details follow indented), and its wall time
 #: is ``summary.json``'s ``timings[name]``
-STAGES = ("mu_design", "mu_analysis", "hinf_lmi_nominal", "hinf_riccati", "limit",
+STAGES = ("mu_design", "mu_analysis", "mu_constrained", "hinf_lmi_nominal", "hinf_riccati",
+          "limit",
           *(f"simulate_{n}" for n in CONTROLLER_NAMES), "iso_C", "monte_carlo", "figures")
 _LONG_NAMES = {"passive": "passive", "hinf_lmi_nominal": "H∞ LMI (no delay)",
-               "hinf_riccati": "H∞ Riccati", "mu": "µ (D-K)"}
+               "hinf_riccati": "H∞ Riccati", "mu": "µ (D-K)",
+               "mu_constrained": "µ, hard bounds"}
+#: sample time of every controller's discrete realization in controllers/<name>.json
+_SAMPLE_TIME = 1e-3
 
 _NOISE_PSD = 1e-4        # (m/s)²/Hz, two-sided; see the module docstring
 _NOISE_BAND_HZ = 50.0
@@ -137,6 +141,12 @@ class ControllerSummary:
         ``peak_z3dd / physical limit`` at each delay.
     error : str
         Why the controller is missing (empty if it was designed).
+    peak_u_command : tuple of float
+        Peak commanded force on the bump at each delay, N (above 1500 N the actuator
+        clips and the loop is not the linear one designed).
+    sampled_peak_z3dd : tuple of float
+        Peak ``|z̈3|`` of the 1 kHz sampled-data loop on the bump at each delay (the
+        controllers shipped with a discrete realization; empty otherwise).
     """
 
     name: str
@@ -148,6 +158,8 @@ class ControllerSummary:
     delay_margin: float
     limit_ratio: tuple
     error: str = ""
+    peak_u_command: tuple = ()
+    sampled_peak_z3dd: tuple = ()
 
     @property
     def stable_on_interval(self) -> bool:
@@ -199,9 +211,17 @@ class ReproduceSummary:
 
 
 def _design_api():
-    """The seat design module (imported late: it is heavy, and tests replace it)."""
-    from ..seat import design
-    return design
+    """The seat designs (imported late: they are heavy, and tests replace them)."""
+    from types import SimpleNamespace
+
+    from ..seat import constrained, design
+    return SimpleNamespace(
+        design_mu_controller=design.design_mu_controller,
+        analyse_uncertainty=design.analyse_uncertainty,
+        design_nominal_hinf=design.design_nominal_hinf,
+        DEFAULT_DESIGN=design.DEFAULT_DESIGN, DEFAULT_MUSYN=design.DEFAULT_MUSYN,
+        load_constrained=constrained.load_constrained,
+        certify_constrained=constrained.certify_constrained)
 
 
 def _jsonable(obj):
@@ -275,7 +295,15 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     Files written: ``fig07_bump.png`` … ``fig15_mu_bounds.png`` (the paper's figures),
     ``peak_vs_delay.png``, ``iso_C_z3dd.png``, ``summary.json`` (non-finite numbers are
     written as ``null``; a ``null`` delay margin means no loss of stability below 1 s) and
-    ``controller.json`` (the µ controller, ``y = [x1, x3]`` in m to ``u`` in N).
+    ``controller.json`` (the µ controller, ``y = [x1, x3]`` in m to ``u`` in N);
+    ``controllers/<name>.json`` for every designed controller, each with its 1 kHz
+    discrete realization (``Ad``, ``Bd``, ``Cd``, ``Dd``, ``dt``);
+    ``force_commanded_vs_applied.png`` and ``mu_bounds_constrained.png``.
+
+    The µ design with hard force and stroke bounds (``mu_constrained``,
+    :func:`~lmi_suspension.seat.constrained.design_constrained_mu`) takes minutes, so the
+    shipped one is loaded and re-certified here (µ bounds, worst-case force and stroke,
+    poles), and simulated like the others, also as its 1 kHz sampled-data loop.
 
     Parameters
     ----------
@@ -307,6 +335,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     """
     from .. import __version__
     from ..io import save_controller, save_controller_mat
+    from ..seat.sampled import discretise_controller, simulate_sampled
     from ..seat import (
         SeatParameters,
         bump,
@@ -370,9 +399,27 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
             f"{check.mu_lower_peak:.4f}")
     done(tok)
 
+    # --- the µ design with hard bounds (shipped: its D-K takes minutes) ---------------
+    tok = stage("mu_constrained", "µ design with hard force/stroke bounds (shipped, "
+                "re-certified) ...")
+    constrained = None
+    errors: dict[str, str] = {}
+    try:
+        K_c, Kd_c, meta_c = api.load_constrained()
+        check_c = api.certify_constrained(K_c, rng=np.random.default_rng(
+            int(rng_analysis.integers(2**63))))
+        constrained = (K_c, Kd_c, meta_c, check_c)
+        say(f"  µ upper {check_c.mu_peak:.4f}, lower {check_c.mu_lower_peak:.4f}; worst case "
+            f"over floor velocities of the bump's energy: |u| {check_c.u_peak:.0f} N, |x1| "
+            f"{check_c.x1_peak:.4f} m; fastest pole {check_c.fastest_pole:.0f} rad/s "
+            f"(controller {check_c.controller_fastest_pole:.0f})")
+    except (LmiSuspensionError, OSError) as exc:
+        errors["mu_constrained"] = f"{type(exc).__name__}: {exc}"
+        say(f"  mu_constrained failed: {errors['mu_constrained']}")
+    done(tok)
+
     # --- comparison controllers ------------------------------------------------------
     controllers: dict[str, object] = {"passive": None}
-    errors: dict[str, str] = {}
     for name, method in (("hinf_lmi_nominal", "lmi"), ("hinf_riccati", "riccati")):
         tok = stage(name, f"nominal H∞ design ({method}, delay ignored) ...")
         try:
@@ -382,6 +429,9 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
             say(f"  {name} failed: {errors[name]}")
         done(tok)
     controllers["mu"] = mu_design.K
+    discrete = {}
+    if constrained is not None:
+        controllers["mu_constrained"], discrete["mu_constrained"] = constrained[:2]
 
     # --- roads and the physical limit ------------------------------------------------
     road_bump = bump(t_end=cfg.bump_t_end, dt=cfg.road_dt)
@@ -434,7 +484,13 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                    "stable_linear": True if K is None else closed_loop_stable(K, d, params)}
             for road_name in ("bump", "noise"):
                 row[road_name] = metrics(runs[road_name][name][d])
+                row[road_name]["peak_u_command"] = float(
+                    np.max(np.abs(runs[road_name][name][d].u_command)))
             row["bump"]["ratio_to_limit"] = row["bump"]["peak_z3dd"] / limit.peak
+            if name in discrete:
+                sampled = simulate_sampled(discrete[name], road_bump, delay=d, params=params)
+                row["bump_sampled"] = dict(metrics(sampled), peak_u_command=float(
+                    np.max(np.abs(sampled.u_command))), sample_time=float(discrete[name].dt))
             rows.append(row)
         entry["per_delay"] = rows
         margin = math.inf if K is None else stability_delay_margin(K, params)
@@ -450,7 +506,10 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
             peak_u=tuple(bump_value(r, "peak_u") for r in rows),
             stable=tuple(bool(r["stable_linear"]) for r in rows),
             delay_margin=margin,
-            limit_ratio=tuple(bump_value(r, "peak_z3dd") / limit.peak for r in rows))
+            limit_ratio=tuple(bump_value(r, "peak_z3dd") / limit.peak for r in rows),
+            peak_u_command=tuple(bump_value(r, "peak_u_command") for r in rows),
+            sampled_peak_z3dd=tuple(r["bump_sampled"]["peak_z3dd"] for r in rows
+                                    if "bump_sampled" in r))
         entry["stable_on_interval"] = s.stable_on_interval
         per_ctrl[name] = entry
         summaries.append(s)
@@ -489,6 +548,22 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     # the same controller for MATLAB / Simulink (lmi-suspension export does it for any file)
     files.append(save_controller_mat(out / "controller.mat", mu_design.K, inputs=["x1", "x3"],
                                      outputs=["u"], metadata=metadata))
+    # every designed controller, with its 1 kHz Tustin realization (the constrained one's
+    # own; a controller with poles above the Nyquist rate is discretised all the same,
+    # and summary.json's fastest poles say so)
+    (out / "controllers").mkdir(exist_ok=True)
+    for name, K in controllers.items():
+        if K is None:
+            continue
+        Kd = discrete.get(name) or discretise_controller(K, _SAMPLE_TIME)
+        meta = dict(metadata) if name == "mu" else (
+            dict(constrained[2]) if name == "mu_constrained" else
+            {"description": f"{_LONG_NAMES[name]}: y = [x1, x3] (m) -> u (N)"})
+        meta["fastest_pole"] = float(np.max(np.abs(np.linalg.eigvals(np.asarray(K.A))))) \
+            if K.nstates else 0.0
+        files.append(save_controller(out / "controllers" / f"{name}.json", K,
+                                     inputs=["x1", "x3"], outputs=["u"], metadata=meta,
+                                     discrete=Kd))
     tok = stage("monte_carlo", f"Monte-Carlo over the uncertainty set ({cfg.mc_n} samples, "
                 f"µ controller, {cfg.mc_workers or 'no'} Dask workers) ...")
     mc_data = _monte_carlo(out / "controller.json", cfg, (delays[0], delays[-1]), params,
@@ -544,6 +619,18 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                                           "(exact delay, saturation)"),
          "peak_vs_delay.png")
     save(figures.plot_responses(iso_runs, "z3dd", title=road_iso.description), "iso_C_z3dd.png")
+    forced = {f"{_LONG_NAMES[n]}, d = {d * 1e3:g} ms": runs["bump"][n][d]
+              for n in ("mu", "mu_constrained") if n in controllers
+              for d in (delays[0], delays[-1])}
+    save(figures.plot_commanded_force(forced, limit=u_max, t_max=1.5,
+                                      title="Bump: commanded (solid) and applied (dashed) "
+                                            "force"),
+         "force_commanded_vs_applied.png")
+    if constrained is not None:
+        check_c = constrained[3]
+        save(figures.plot_mu_bounds(check_c.omega, check_c.mu_upper, check_c.mu_lower,
+                                    title="µ bounds, µ design with hard force/stroke bounds"),
+             "mu_bounds_constrained.png")
     done(tok)
 
     # --- summary.json ---------------------------------------------------------------
@@ -573,6 +660,8 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                "design_seconds": getattr(mu_design, "seconds", None)},
         "design_options": metadata["design_options"],
         "musyn_options": metadata["musyn_options"],
+        "mu_constrained": None if constrained is None else {
+            "check": constrained[3], "design": constrained[2]},
         "timings": timings,
     }
     data = _jsonable(data)
@@ -595,7 +684,8 @@ def comparison_table(summary: ReproduceSummary) -> str:
 
     Columns: peak ``|z̈3|`` on the bump at the smallest and largest delay, its ratio to the
     physical limit at the largest delay, the worst peak ``|x1|`` and ``|u|`` over the delays,
-    the delay margin and whether the loop is stable over the whole delay range.
+    the largest commanded force, the delay margin and whether the loop is stable over the
+    whole delay range.
 
     Examples
     --------
@@ -603,12 +693,12 @@ def comparison_table(summary: ReproduceSummary) -> str:
     ...                       (True, True), 0.05, (0.5, 0.65))
     >>> summ = ReproduceSummary(Path("."), (), (s,), 6.17, 0.9, 0.8, 1.0, {}, {})
     >>> print(comparison_table(summ).splitlines()[2])  # doctest: +NORMALIZE_WHITESPACE
-    µ (D-K)  3.000  4.000  0.65  0.0200  900  50.0  yes
+    µ (D-K)  3.000  4.000  0.65  0.0200  900  n/a  50.0  yes
     """
     d0, d1 = summary.controllers[0].delays[0], summary.controllers[0].delays[-1]
     head = (f"{'controller':<18} {'z3dd@' + format(d0 * 1e3, 'g') + 'ms':>10} "
             f"{'z3dd@' + format(d1 * 1e3, 'g') + 'ms':>10} {'/limit':>7} {'x1 [m]':>8} "
-            f"{'u [N]':>7} {'margin[ms]':>10} {'stable':>7}")
+            f"{'u [N]':>7} {'u cmd':>7} {'margin[ms]':>10} {'stable':>7}")
     lines = [head, "-" * len(head)]
     for c in summary.controllers:
         name = _LONG_NAMES.get(c.name, c.name)
@@ -617,6 +707,8 @@ def comparison_table(summary: ReproduceSummary) -> str:
             continue
         worst_x1 = max(c.peak_x1) if all(map(math.isfinite, c.peak_x1)) else math.nan
         worst_u = max(c.peak_u) if all(map(math.isfinite, c.peak_u)) else math.nan
+        worst_cmd = max(c.peak_u_command) if c.peak_u_command and all(
+            map(math.isfinite, c.peak_u_command)) else math.nan
         if c.name == "passive":
             margin, stable = "no loop", "yes"
         else:
@@ -625,7 +717,8 @@ def comparison_table(summary: ReproduceSummary) -> str:
             stable = "yes" if c.stable_on_interval else "NO"
         lines.append(f"{name:<18} {_fmt(c.peak_z3dd[0], '.3f'):>10} "
                      f"{_fmt(c.peak_z3dd[-1], '.3f'):>10} {_fmt(c.limit_ratio[-1], '.2f'):>7} "
-                     f"{_fmt(worst_x1, '.4f'):>8} {_fmt(worst_u, '.0f'):>7} {margin:>10} "
+                     f"{_fmt(worst_x1, '.4f'):>8} {_fmt(worst_u, '.0f'):>7} "
+                     f"{_fmt(worst_cmd, '.0f'):>7} {margin:>10} "
                      f"{stable:>7}")
     lines.append(f"physical limit (LP, full road knowledge): {summary.limit_peak:.3f} m/s²; "
                  f"µ peak upper {summary.mu_peak:.4f}, lower {summary.mu_lower_peak:.4f}")

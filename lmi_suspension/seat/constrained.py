@@ -1,0 +1,312 @@
+"""Robust µ-synthesis of the seat with hard force and stroke bounds in every K-step.
+
+The paper's µ design (:mod:`.design`) meets the 1500 N force limit only because the
+actuator clips: its linear loop commands up to 2564 N on the bump.  Here the limits are
+constraints of D-K iteration itself (:func:`~lmi_suspension.mu.musyn` with
+``constraints``): every K-step is the multi-objective LMI synthesis of
+:func:`~lmi_suspension.synthesis.msyn` on the D-scaled plant, minimising the scaled µ
+channels' H∞ norm subject to
+
+* generalized-H2 (energy-to-peak) bounds on the nominal loop: ``|u(t)| <= u_bound`` and
+  ``|x1(t)| <= z_bound`` for every floor velocity of the bump's energy (Wilson, IEEE TAC
+  34(1), 1989; the plant's extra channels of
+  :func:`~lmi_suspension.seat.augmented.seat_augmented_plant` with ``peak_channels``);
+* closed-loop poles in the disk ``|s| < disk_radius``, so that a 1 kHz implementation
+  resolves them (Nyquist rate π · 1000 ≈ 3142 rad/s).
+
+An energy bound holds for every floor velocity of that energy, so it is conservative for
+the bump itself: the worst road of the bump's energy asks 2.2–2.8 times the bump's force
+(measured on the µ and constrained controllers).  ``u_bound`` is therefore chosen so that
+the *bump* stays within the actuator's 1500 N at every delay, which the exact-delay
+simulation checks; :func:`force_tradeoff` shows what each bound costs.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import control
+import numpy as np
+
+from ..mu import MusynOptions, MusynResult, musyn
+from ..synthesis.constraints import Channel, Disk, PeakBound
+from .augmented import SeatDesignOptions, seat_augmented_plant
+from .bounded import road_energy
+from .design import DEFAULT_DESIGN, DEFAULT_OMEGA, _named
+from .params import SeatParameters
+from .roads import bump
+from .sampled import DEFAULT_SAMPLE_TIME, discretise_controller
+
+__all__ = ["ConstrainedMuDesign", "ConstrainedCheck", "CONSTRAINED_MUSYN",
+           "CONSTRAINED_DESIGN", "CONSTRAINED_OMEGA",
+           "certify_constrained", "design_constrained_mu", "load_constrained",
+           "save_constrained", "SHIPPED_CONTROLLER"]
+
+#: the constrained design shipped with the package (``lmi-suspension design-constrained``
+#: writes it; ``reproduce`` loads and re-certifies it)
+SHIPPED_CONTROLLER = Path(__file__).parent / "data" / "mu_constrained.json"
+
+logger = logging.getLogger(__name__)
+
+#: D-K settings of the constrained design: the LMI K-step (the only one that takes
+#: constraints), constant D-scales as in DEFAULT_MUSYN, at most four iterations.
+CONSTRAINED_MUSYN = MusynOptions(method="lmi", max_iter=4, patience=1, max_dfit_order=0,
+                                 n_dense=120, dscale_overrelax=1.0)
+
+#: Design grid, rad/s: DEFAULT_OMEGA extended two decades down.  A constrained K-step's
+#: loop can lose performance near DC where the paper's design does not: the 4000 N design
+#: with the 50-point grid from 0.1 rad/s certified µ 1.218 on it and 2.343 at 1e-3 rad/s
+#: (2026-11-25).
+CONSTRAINED_OMEGA = np.logspace(-3.0, 3.5, 66)
+
+#: The µ weights of the constrained design: DEFAULT_DESIGN with the force error scaled by
+#: 20000 N instead of 7000 N -- the hard bound limits the force now, and the H∞ objective
+#: is left to comfort and robustness (at 4000 N / 0.16 m / disk 2000: bump peak 11.8 m/s²
+#: at 0 ms against 13.9 with 7000 N, measured 2026-11-25).
+CONSTRAINED_DESIGN = replace(DEFAULT_DESIGN, u_max=20000.0)
+
+#: Lyapunov scales of the force/stroke bound and the disk (msyn's ``lyapunov_scales``):
+#: the search of the first K-step found 1.35e5–1.40e5 for the force bound at 3000 N on
+#: the default weights (2026-11-25); giving it saves that search (~15 minimisations,
+#: 40 s to 6 min), and musyn searches again if a K-step fails with it.
+_LYAPUNOV_SCALES = (1.4e5, 1.0)
+
+
+@dataclass(frozen=True)
+class ConstrainedMuDesign:
+    """A seat controller of :func:`design_constrained_mu` and its certificates.
+
+    Attributes
+    ----------
+    K : control.StateSpace
+        Continuous-time controller, ``y = [x1, x3]`` (m) to ``u`` (N).
+    Kd : control.StateSpace
+        Its 1 kHz Tustin realization (:func:`~.sampled.discretise_controller`).
+    musyn : MusynResult
+        The D-K result; ``musyn.certificates`` recomputes each bound on the unscaled loop.
+    mu_peak, mu_lower_peak : float
+        µ upper and lower bound peaks on the dense grid (delay cover 0–25 ms and
+        performance).
+    u_bound, z_bound, energy, disk_radius : float
+        What was asked: ``|u| <= u_bound``, ``|x1| <= z_bound`` for every floor velocity
+        with ``‖ż0‖₂ <= energy``; closed-loop poles in ``|s| < disk_radius``.
+    u_peak, x1_peak : float
+        The worst-case peaks the closed loop achieves for that energy (its Gramian).
+    fastest_pole, controller_fastest_pole : float
+        Largest closed-loop and controller pole magnitudes, rad/s.
+    seconds : float
+        Wall time of the design.
+    """
+
+    K: control.StateSpace
+    Kd: control.StateSpace
+    musyn: MusynResult
+    mu_peak: float
+    mu_lower_peak: float
+    u_bound: float
+    z_bound: float
+    energy: float
+    disk_radius: float
+    u_peak: float
+    x1_peak: float
+    fastest_pole: float
+    controller_fastest_pole: float
+    seconds: float
+
+    def __iter__(self):
+        # like musyn: K, CL, mu_peak, info
+        return iter((self.K, self.musyn.CL, self.mu_peak, self))
+
+
+@dataclass(frozen=True)
+class ConstrainedCheck:
+    """What a seat controller achieves against the constrained design's requirements,
+    recomputed from the controller alone (:func:`certify_constrained`).
+
+    Attributes
+    ----------
+    mu_peak, mu_lower_peak : float
+        µ bounds' peaks over ``omega`` (delay cover 0–25 ms and performance).
+    omega, mu_upper, mu_lower : ndarray
+        The grid (rad/s) and the bounds on it.
+    u_peak, x1_peak : float
+        Worst-case ``|u|`` (N) and ``|x1|`` (m) over every floor velocity of energy
+        ``energy`` (closed-loop Gramian).
+    energy : float
+    fastest_pole, controller_fastest_pole : float
+        Largest closed-loop and controller pole magnitudes, rad/s.
+    """
+
+    mu_peak: float
+    mu_lower_peak: float
+    omega: np.ndarray
+    mu_upper: np.ndarray
+    mu_lower: np.ndarray
+    u_peak: float
+    x1_peak: float
+    energy: float
+    fastest_pole: float
+    controller_fastest_pole: float
+
+
+def certify_constrained(K, *, design: SeatDesignOptions | None = None,
+                        params: SeatParameters | None = None, energy: float | None = None,
+                        omega=None, rng: np.random.Generator | None = None
+                        ) -> ConstrainedCheck:
+    """µ bounds, worst-case force and stroke, and pole magnitudes of a seat controller
+    (any: the µ controller's figures come out the same way).
+
+    Examples
+    --------
+    >>> import control
+    >>> c = certify_constrained(control.ss([], [], [], [[0.0, 0.0]]),
+    ...                         omega=np.logspace(-1, 3, 20))
+    >>> c.u_peak, round(c.x1_peak, 4)      # the passive seat: no force, 0.064 m
+    (0.0, 0.0642)
+    """
+    from ..lti import freqresp, lft
+    from ..mu import mussv
+    from ..mu.dk import _mu_part
+    from ..mu.blocks import BlockStructure
+
+    E = road_energy(bump()) if energy is None else float(energy)
+    aug = seat_augmented_plant(CONSTRAINED_DESIGN if design is None else design, params,
+                               peak_channels=True)
+    omega = (np.logspace(np.log10(CONSTRAINED_OMEGA[0]), np.log10(CONSTRAINED_OMEGA[-1]),
+                         300) if omega is None else np.asarray(omega, dtype=float))
+    K = control.ss(K.A, K.B, K.C, K.D)
+    CL = lft(aug.P, K, aug.nmeas, aug.ncon)
+    nz, nw = BlockStructure.coerce(aug.blk).shape_M
+    bounds = mussv(freqresp(_mu_part(CL, BlockStructure.coerce(aug.blk)), omega), aug.blk,
+                   omega=omega, rng=np.random.default_rng(0) if rng is None else rng)
+    peaks = PeakBound(Channel(outputs=(nz, nz + 1), inputs=(nw,)), (1.0, 1.0)).peaks(CL) * E
+    fast = (lambda M: float(np.max(np.abs(np.linalg.eigvals(M)))) if M.size else 0.0)
+    return ConstrainedCheck(
+        mu_peak=float(np.max(bounds.upper)), mu_lower_peak=float(np.max(bounds.lower)),
+        omega=omega, mu_upper=np.asarray(bounds.upper), mu_lower=np.asarray(bounds.lower),
+        u_peak=float(peaks[0]), x1_peak=float(peaks[1]), energy=E,
+        fastest_pole=fast(np.asarray(CL.A)), controller_fastest_pole=fast(np.asarray(K.A)))
+
+
+def design_constrained_mu(u_bound: float = 4000.0, z_bound: float = 0.16, *,
+                          disk_radius: float = 2000.0, energy: float | None = None,
+                          design: SeatDesignOptions | None = None,
+                          params: SeatParameters | None = None,
+                          musyn_options: MusynOptions | None = None, omega=None,
+                          sample_time: float = DEFAULT_SAMPLE_TIME, lyapunov_scales=None,
+                          callback=None, rng: np.random.Generator | None = None
+                          ) -> ConstrainedMuDesign:
+    """Robust seat controller by µ-synthesis with hard force, stroke and pole bounds.
+
+    Parameters
+    ----------
+    u_bound : float
+        Force bound, N, for every floor velocity of energy ``energy``.
+    z_bound : float
+        Stroke bound on ``|x1|``, m, for the same floor velocities.
+    disk_radius : float
+        Closed-loop poles in ``|s| < disk_radius`` (rad/s).
+    energy : float, optional
+        ``‖ż0‖₂`` the bounds hold for (the bump's, 0.4534, by default).
+    design : SeatDesignOptions, optional
+        µ weights and uncertainty (default :data:`CONSTRAINED_DESIGN`).
+    params : SeatParameters, optional
+    musyn_options : MusynOptions, optional
+        Default :data:`CONSTRAINED_MUSYN`; its method must be ``"lmi"``.
+    omega : array_like, optional
+        Design grid, rad/s (default :data:`CONSTRAINED_OMEGA`).
+    sample_time : float
+        Sample time of the discrete realization ``Kd``, s.
+    lyapunov_scales : sequence of float, optional
+        :func:`~lmi_suspension.synthesis.msyn`'s scales for the bound and the disk (the
+        measured ones by default; ``()`` lets the first K-step search them).
+    callback : callable, optional
+        Called with each D-K iteration's record (progress).
+    rng : numpy.random.Generator, optional
+        Seeds the µ lower bound.
+
+    Returns
+    -------
+    ConstrainedMuDesign
+
+    Raises
+    ------
+    InfeasibleError
+        No controller meets the bounds (with a common Lyapunov matrix).
+    ParameterError
+        Non-positive bounds or energy.
+    """
+    from ..errors import ParameterError
+
+    t0 = time.perf_counter()
+    E = road_energy(bump()) if energy is None else float(energy)
+    for name, value in (("u_bound", u_bound), ("z_bound", z_bound), ("energy", E),
+                        ("disk_radius", disk_radius)):
+        if not (np.isfinite(value) and value > 0):
+            raise ParameterError(f"{name} must be positive and finite, got {value!r}")
+    aug = seat_augmented_plant(CONSTRAINED_DESIGN if design is None else design, params,
+                               peak_channels=True)
+    nz, nw = int(sum(c for _, c in np.abs(aug.blk))), int(sum(r for r, _ in np.abs(aug.blk)))
+    road, u_cmd, x1 = nw, nz, nz + 1  # the channels beyond blk (see peak_channels)
+    bound = PeakBound(Channel(outputs=(u_cmd, x1), inputs=(road,)),
+                      (float(u_bound) / E, float(z_bound) / E), name="peak u, x1")
+    constraints = [bound, Disk(radius=float(disk_radius))]
+    scales = _LYAPUNOV_SCALES if lyapunov_scales is None else (
+        None if len(lyapunov_scales) == 0 else tuple(lyapunov_scales))
+    res = musyn(aug.P, aug.nmeas, aug.ncon, aug.blk,
+                omega=CONSTRAINED_OMEGA if omega is None else omega,
+                options=CONSTRAINED_MUSYN if musyn_options is None else musyn_options,
+                callback=callback, rng=np.random.default_rng(0) if rng is None else rng,
+                constraints=constraints, lyapunov_scales=scales)
+    from ..lti import lft
+
+    CL = lft(aug.P, res.K, aug.nmeas, aug.ncon)
+    peaks = PeakBound(bound.channel, (1.0, 1.0)).peaks(CL) * E
+    K = _named(res.K)
+    seconds = time.perf_counter() - t0
+    logger.info("constrained seat µ design: µ %.4f (lower %.4f), worst-case %.0f N / "
+                "%.4f m, %.1f s", res.mu_peak, res.mu_lower_peak, peaks[0], peaks[1],
+                seconds)
+    return ConstrainedMuDesign(
+        K=K, Kd=discretise_controller(K, sample_time), musyn=res, mu_peak=res.mu_peak,
+        mu_lower_peak=res.mu_lower_peak, u_bound=float(u_bound), z_bound=float(z_bound),
+        energy=E, disk_radius=float(disk_radius), u_peak=float(peaks[0]),
+        x1_peak=float(peaks[1]),
+        fastest_pole=float(np.max(np.abs(np.linalg.eigvals(np.asarray(CL.A))))),
+        controller_fastest_pole=float(np.max(np.abs(np.linalg.eigvals(np.asarray(K.A)))))
+        if K.nstates else 0.0,
+        seconds=seconds)
+
+
+def save_constrained(path, d: ConstrainedMuDesign) -> Path:
+    """Write a constrained design as a controller file (``controller.json``'s format with
+    the discrete realization and the design's figures in its metadata)."""
+    from ..io import save_controller
+
+    meta = {"description": "µ-synthesis seat controller with hard force/stroke bounds and a "
+                           "pole disk in every K-step: y = [x1, x3] (m) -> u (N)",
+            "mu_peak_upper": d.mu_peak, "mu_peak_lower": d.mu_lower_peak,
+            "u_bound": d.u_bound, "z_bound": d.z_bound, "energy": d.energy,
+            "disk_radius": d.disk_radius, "u_peak": d.u_peak, "x1_peak": d.x1_peak,
+            "discretisation": f"Tustin, dt = {d.Kd.dt} s",
+            "design_seconds": d.seconds,
+            "history": [{"index": h.index, "gamma": h.gamma, "mu_peak": h.mu_peak,
+                         "mu_lower_peak": h.mu_lower_peak}
+                        for h in d.musyn.history],
+            "stop_reason": d.musyn.stop_reason}
+    return save_controller(path, d.K, inputs=["x1", "x3"], outputs=["u"], metadata=meta,
+                           discrete=d.Kd)
+
+
+def load_constrained(path=None) -> tuple:
+    """``(K, Kd, metadata)`` of a file written by :func:`save_constrained` (the shipped
+    design by default)."""
+    from ..io import load_controller, load_discrete_controller
+
+    path = SHIPPED_CONTROLLER if path is None else Path(path)
+    K, meta = load_controller(path)
+    Kd, _ = load_discrete_controller(path)
+    return K, Kd, meta
