@@ -356,13 +356,15 @@ def _synthesise(G: GeneralizedPlant, objective, constraints, options, lyapunov_s
     first = identity
     searched = [k for k, s in enumerate(specs, start=1)
                 if _scalable(s) and lyapunov_scales is None]
-    if searched:
-        # a constraint no controller meets fails here in one solve, not after a search
-        # of failed minimisations (the seat at 1 N / 0.01 m: 12 s before, 0.1 s after,
-        # idle 2-core machine, 2026-11-25).  Each alone: its own Lyapunov scale does
-        # not change its feasible controllers, the relative scales of several do
-        for k in searched:
+    # a constraint no controller meets fails here in one solve, not after a search or
+    # a ladder of failed minimisations (the seat at 1 N / 0.01 m: 12 s before, 0.1 s
+    # after, idle 2-core machine, 2026-11-25; with given scales on the seat's µ plant,
+    # 165 s before).  Each alone: its own Lyapunov scale does not change its feasible
+    # controllers, the relative scales of several do
+    for k, s in enumerate(specs, start=1):
+        if _scalable(s):
             raise_if_infeasible(only=k)
+    if searched:
         # the search runs in the frame of the objective's optimum alone
         alone = minimise(identity, with_constraints=False)
         if alone is not None:

@@ -1,0 +1,97 @@
+"""The seat's µ design with hard force and stroke bounds (issue 17).
+
+The shipped controller (``lmi-suspension design-constrained``) is checked by computations
+that did not produce it: µ bounds by ``mussv`` on a grid of its own, the worst-case force
+and stroke by the closed loop's Gramian, its poles, the Tustin map recomputed by
+python-control, and exact-delay simulations of the continuous and the 1 kHz sampled-data
+loop on the paper's bump.
+"""
+
+from dataclasses import replace
+
+import control
+import numpy as np
+import pytest
+
+from lmi_suspension.errors import InfeasibleError, ParameterError
+from lmi_suspension.seat.constrained import (CONSTRAINED_MUSYN, SHIPPED_CONTROLLER,
+                                             certify_constrained, design_constrained_mu,
+                                             load_constrained)
+from lmi_suspension.seat.roads import bump
+from lmi_suspension.seat.sampled import simulate_sampled
+from lmi_suspension.seat.simulate import closed_loop_stable, simulate
+
+DELAYS = (0.0, 0.005, 0.01, 0.015, 0.02, 0.025)
+
+
+@pytest.fixture(scope="module")
+def shipped():
+    K, Kd, meta = load_constrained()
+    return K, Kd, meta, certify_constrained(K)
+
+
+def test_shipped_file_is_the_package_data():
+    assert SHIPPED_CONTROLLER.is_file()
+
+
+def test_shipped_bounds_hold_on_the_loop_recomputed_here(shipped):
+    K, Kd, meta, check = shipped
+    # the worst case over every floor velocity of the bump's energy, from the Gramian
+    assert check.u_peak <= meta["u_bound"] * (1 + 5e-3)
+    assert check.x1_peak <= meta["z_bound"] * (1 + 5e-3)
+    assert check.fastest_pole < meta["disk_radius"]
+    # µ on this grid (300 points) against the design's dense grid: the same peak within
+    # the grids' difference, lower <= upper
+    assert check.mu_lower_peak <= check.mu_peak * (1 + 1e-6)
+    assert check.mu_peak == pytest.approx(meta["mu_peak_upper"], rel=0.03)
+
+
+def test_shipped_discrete_realization_is_the_tustin_map(shipped):
+    K, Kd, _, _ = shipped
+    assert Kd.dt == 1e-3
+    ref = control.sample_system(K, 1e-3, method="bilinear")
+    for w in (1.0, 30.0, 300.0):
+        z = np.exp(1j * w * 1e-3)
+        assert np.allclose(np.asarray(Kd(z)), np.asarray(ref(z)), rtol=1e-8)
+
+
+@pytest.mark.parametrize("delay", DELAYS)
+def test_shipped_controller_on_the_bump(shipped, delay):
+    """Issue 17's acceptance per delay: the linear loop (no clipping) stays within the
+    1500 N actuator and the 0.08 m stroke, and the 1 kHz sampled-data loop reproduces
+    the continuous loop's peak within 5 %."""
+    K, Kd, _, _ = shipped
+    assert closed_loop_stable(K, delay)
+    cont = simulate(K, bump(), delay=delay, u_max=np.inf)
+    assert np.max(np.abs(cont.u_command)) <= 1500.0
+    assert np.max(np.abs(cont.x1)) <= 0.08
+    sampled = simulate_sampled(Kd, bump(), delay=delay)  # clipping at 1500 N on
+    peak_c, peak_s = np.max(np.abs(cont.z3dd)), np.max(np.abs(sampled.z3dd))
+    assert abs(peak_s - peak_c) <= 0.05 * peak_c
+    assert sampled.saturated_fraction == 0.0
+
+
+def test_design_without_the_disk_meets_its_bounds():
+    """One K-step without the pole disk (about 10 s): every figure recomputed by
+    certify_constrained, which shares no code with the synthesis's own certificates."""
+    d = design_constrained_mu(4000.0, 0.16, disk_radius=None,
+                              musyn_options=replace(CONSTRAINED_MUSYN, max_iter=1))
+    assert all(c.met for c in d.musyn.certificates)
+    check = certify_constrained(d.K)
+    assert check.u_peak <= 4000.0 * (1 + 5e-3) and check.x1_peak <= 0.16 * (1 + 5e-3)
+    assert check.u_peak == pytest.approx(d.u_peak, rel=1e-6)
+    assert np.isinf(d.disk_radius)
+
+
+@pytest.mark.parametrize("kwargs", [dict(u_bound=0.0), dict(z_bound=-1.0),
+                                    dict(disk_radius=np.nan), dict(energy=0.0)])
+def test_bad_bounds_are_typed_errors(kwargs):
+    with pytest.raises(ParameterError):
+        design_constrained_mu(**kwargs)
+
+
+def test_bounds_no_controller_meets_are_infeasible():
+    # 1 N of force cannot hold the stroke below 1 cm (the passive seat's worst case for
+    # the bump's energy is 6.4 cm)
+    with pytest.raises(InfeasibleError):
+        design_constrained_mu(1.0, 0.01, disk_radius=None)
