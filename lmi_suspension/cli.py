@@ -387,7 +387,7 @@ def build_parser() -> argparse.ArgumentParser:
                           help="µ-synthesis with hard force/stroke bounds and a pole disk in "
                                "every K-step (minutes); writes the controller file "
                                "reproduce loads")
-    p_dc.add_argument("--u-bound", type=float, default=4000.0,
+    p_dc.add_argument("--u-bound", type=float, default=9000.0,
                       help="|u| bound, N, for every floor velocity of the bump's energy")
     p_dc.add_argument("--z-bound", type=float, default=0.16, help="|x1| bound, m, likewise")
     p_dc.add_argument("--disk-radius", type=float, default=2000.0,

@@ -199,7 +199,7 @@ def certify_constrained(K, *, design: SeatDesignOptions | None = None,
         fastest_pole=fast(np.asarray(CL.A)), controller_fastest_pole=fast(np.asarray(K.A)))
 
 
-def design_constrained_mu(u_bound: float = 3600.0, z_bound: float = 0.16, *,
+def design_constrained_mu(u_bound: float = 9000.0, z_bound: float = 0.16, *,
                           disk_radius: float | None = 2000.0, energy: float | None = None,
                           design: SeatDesignOptions | None = None,
                           params: SeatParameters | None = None,
