@@ -85,6 +85,9 @@ def test_simulate_writes_plot(capsys, gain_file, tmp_path):
     (["--controller", "{gain}", "--duration", "0"], "duration"),
     (["--controller", "{bad}"], "not valid JSON"),
     (["--controller", "{wrong}"], "not a saved controller"),
+    (["--controller", "{gain}", "--discrete"], "no discrete realization"),
+    (["--controller", "{gain}", "--noise", "1e-4,1e-4"], "--discrete"),
+    (["--controller", "{sampled}", "--discrete", "--noise", "1e-4"], "two standard"),
 ])
 def test_errors_exit_2_with_one_line(capsys, gain_file, tmp_path, args, words):
     bad = tmp_path / "bad.json"
@@ -92,7 +95,12 @@ def test_errors_exit_2_with_one_line(capsys, gain_file, tmp_path, args, words):
     wrong = tmp_path / "wrong.json"
     wrong.write_text('{"inputs": ["x1", "x3"], "outputs": ["u"], "D": [[1.0, 2.0]], '
                      '"A": [[-1.0]]}')  # B and C missing
-    names = {"missing": tmp_path / "nope.json", "gain": gain_file, "bad": bad, "wrong": wrong}
+    sampled = tmp_path / "sampled.json"
+    K = control.ss([], [], [], [[20000.0, 0.0]])
+    save_controller(sampled, K, inputs=["x1", "x3"], outputs=["u"],
+                    discrete=control.ss([], [], [], [[20000.0, 0.0]], 1e-3))
+    names = {"missing": tmp_path / "nope.json", "gain": gain_file, "bad": bad, "wrong": wrong,
+             "sampled": sampled}
     argv = ["simulate"] + [a.format(**names) for a in args]
     with pytest.raises(SystemExit) as exc:
         main(argv)
@@ -109,3 +117,21 @@ def test_console_error_has_no_traceback(tmp_path):
                           capture_output=True, text=True, timeout=60, check=False)
     assert proc.returncode == 2
     assert proc.stderr.strip().count("\n") == 0 and "Traceback" not in proc.stderr
+
+
+def test_simulate_discrete_runs_the_sampled_data_loop(capsys, tmp_path):
+    """The file's discrete realization in the 1 kHz loop: the same figures as calling
+    simulate_sampled directly."""
+    from lmi_suspension.seat.sampled import discretise_controller, simulate_sampled
+
+    K = control.ss([[-200.0]], [[200.0, 0.0]], [[15000.0]], [[0.0, 2000.0]])
+    Kd = discretise_controller(K, 1e-3)
+    path = tmp_path / "k.json"
+    save_controller(path, K, inputs=["x1", "x3"], outputs=["u"], discrete=Kd)
+    data = _json_run(capsys, "--controller", path, "--discrete", "--delay", "0.01",
+                     "--duration", "1")
+    direct = simulate_sampled(Kd, bump(t_end=1.0), delay=0.01)
+    assert data["realization"].startswith("discrete, 1000 Hz")
+    assert data["peak_z3dd"] == pytest.approx(np.max(np.abs(direct.z3dd)), rel=1e-12)
+    assert data["peak_u_command"] == pytest.approx(np.max(np.abs(direct.u_command)),
+                                                   rel=1e-12)
