@@ -15,10 +15,12 @@ channels' H∞ norm subject to
   resolves them (Nyquist rate π · 1000 ≈ 3142 rad/s).
 
 An energy bound holds for every floor velocity of that energy, so it is conservative for
-the bump itself: the worst road of the bump's energy asks 2.2–2.8 times the bump's force
-(measured on the µ and constrained controllers).  ``u_bound`` is therefore chosen so that
-the *bump* stays within the actuator's 1500 N at every delay, which the exact-delay
-simulation checks.
+the bump itself: the worst road of the bump's energy asks 1.8–2.2 times the bump's force
+(measured on the µ and constrained controllers), and the common Lyapunov matrix of the
+LMIs adds its own margin (the certified worst case is 0.25–0.49 of the bound asked,
+2026-11-25).  ``u_bound`` is therefore a knob, chosen so that the *bump* stays within
+the actuator's 1500 N at every delay, which the exact-delay simulation checks: 9000 N
+gives at most 1095 N on the bump.
 
 A design takes minutes (each K-step with the disk about 70–110 s on a 2-core machine),
 so ``reproduce`` loads the shipped one (:data:`SHIPPED_CONTROLLER`, written by
