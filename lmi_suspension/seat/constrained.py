@@ -79,8 +79,12 @@ CONSTRAINED_DESIGN = replace(DEFAULT_DESIGN, u_max=20000.0)
 
 #: Lyapunov scales of the force/stroke bound and the disk (msyn's ``lyapunov_scales``):
 #: the search of the first K-step found 1.35e5–1.40e5 for the force bound at 3000 N on
-#: the default weights (2026-11-25); giving it saves that search (~15 minimisations,
-#: 40 s to 6 min), and musyn searches again if a K-step fails with it.
+#: the paper's weights (2026-11-25); giving it saves that search (~15 minimisations,
+#: 1 min without the disk, 6 min with it), and musyn searches again if a K-step fails
+#: with it.  The search optimises the first K-step's γ, not the design: at 9000 N with
+#: the disk it found a scale whose D-K ended nearly passive (µ 3.05, 240 N and 24.3
+#: m/s² on the bump, against µ 2.57, 1038 N and 17.2 m/s² with this one); without the
+#: disk it did better (12.8 against 16.6 m/s² at 0 ms, µ 2.04 against 1.86).
 _LYAPUNOV_SCALES = (1.4e5, 1.0)
 
 
