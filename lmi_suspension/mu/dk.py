@@ -676,20 +676,22 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
                 stop_reason += f"; D-scale search to µ {found.mu_peak:.4f}"
 
     mu_best, K, best_it = best
-    CL = balanced_statespace(_mu_part(lft(G, K), struct))
+    CL_full = lft(G, K)
+    CL = balanced_statespace(_mu_part(CL_full, struct))
     dense = _dense_grid(omega, int(opts.n_dense), history[best_it - 1].peak_omega, CL)
     final, _ = _mu_bounds(CL, struct, dense, rng)
     reduced_from = None
     if opts.reduce_order is not None and int(opts.reduce_order) < K.nstates:
         K_red = _try_reduce(K, int(opts.reduce_order))
         if K_red is not None:
-            CL_red = balanced_statespace(_mu_part(lft(G, K_red), struct))
+            CL_red_full = lft(G, K_red)
+            CL_red = balanced_statespace(_mu_part(CL_red_full, struct))
             if np.all(np.real(CL_red.poles()) < 0) and all(
-                    c.met for c in _certificates(constraints, lft(G, K_red))):
+                    c.met for c in _certificates(constraints, CL_red_full)):
                 final_red, _ = _mu_bounds(CL_red, struct, dense, rng)
                 if np.max(final_red.upper) <= np.max(final.upper) * (1 + opts.reduce_mu_tol):
                     reduced_from = K.nstates
-                    K, CL, final = K_red, CL_red, final_red
+                    K, CL, CL_full, final = K_red, CL_red, CL_red_full, final_red
                 else:
                     logger.info("musyn: reduced controller rejected (µ %.4f vs %.4f)",
                                 np.max(final_red.upper), np.max(final.upper))
@@ -700,22 +702,22 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
         peak_omega=float(dense[k_peak]), mu=final, history=tuple(history),
         best_iteration=best_it, stop_reason=stop_reason, reduced_from=reduced_from,
         seconds=time.perf_counter() - t_start, omega=omega,
-        certificates=_certificates(constraints, lft(G, K)))
+        certificates=_certificates(constraints, CL_full))
 
 
 def _resonances(CL: control.StateSpace, omega: np.ndarray) -> np.ndarray:
-    """Frequencies (rad/s) of the loop's lightly damped poles (damping below 0.3) within
-    the design range, each with its neighbours at ±1 % of a half-power width."""
+    """Frequencies (rad/s) of the loop's lightly damped poles (damping ζ below 0.3)
+    within the design range: each pole's |p| and |Im p|, and the edges ``|p| (1 ± ζ)`` of
+    its half-power band."""
     p = np.linalg.eigvals(np.asarray(CL.A)) if CL.nstates else np.zeros(0)
-    p = p[(p.imag > 0) & (np.abs(p) > 0)]
-    zeta = -p.real / np.abs(p)
-    p = p[zeta < 0.3]
+    p = p[p.imag > 0]
     w = np.abs(p)
-    keep = (w >= omega[0]) & (w <= omega[-1])
-    w, z = w[keep], (-p.real / np.abs(p))[keep]
+    z = -p.real / w
+    keep = (z < 0.3) & (w >= omega[0]) & (w <= omega[-1])
+    p, w, z = p[keep], w[keep], z[keep]
     if not w.size:
         return np.zeros(0)
-    pts = np.concatenate([w, w * (1 - z), w * (1 + z), np.abs(p.imag[keep])])
+    pts = np.concatenate([w, w * (1 - z), w * (1 + z), p.imag])
     return np.unique(pts[pts > 0])
 
 

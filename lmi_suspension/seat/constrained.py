@@ -193,8 +193,9 @@ def certify_constrained(K, *, design: SeatDesignOptions | None = None,
                          300) if omega is None else np.asarray(omega, dtype=float))
     K = control.ss(K.A, K.B, K.C, K.D)
     CL = lft(aug.P, K, aug.nmeas, aug.ncon)
-    nz, nw = BlockStructure.coerce(aug.blk).shape_M
-    bounds = mussv(freqresp(_mu_part(CL, BlockStructure.coerce(aug.blk)), omega), aug.blk,
+    struct = BlockStructure.coerce(aug.blk)
+    nz, nw = struct.shape_M
+    bounds = mussv(freqresp(_mu_part(CL, struct), omega), aug.blk,
                    omega=omega, rng=np.random.default_rng(0) if rng is None else rng)
     peaks = PeakBound(Channel(outputs=(nz, nz + 1), inputs=(nw,)), (1.0, 1.0)).peaks(CL) * E
     fast = (lambda M: float(np.max(np.abs(np.linalg.eigvals(M)))) if M.size else 0.0)
@@ -265,8 +266,12 @@ def design_constrained_mu(u_bound: float = 9000.0, z_bound: float = 0.16, *,
             raise ParameterError(f"{name} must be positive and finite, got {value!r}")
     aug = seat_augmented_plant(CONSTRAINED_DESIGN if design is None else design, params,
                                peak_channels=True)
-    nz, nw = int(sum(c for _, c in np.abs(aug.blk))), int(sum(r for r, _ in np.abs(aug.blk)))
-    road, u_cmd, x1 = nw, nz, nz + 1  # the channels beyond blk (see peak_channels)
+    from ..mu.blocks import BlockStructure
+
+    # the channels beyond blk (see peak_channels); shape_M counts a real scalar [-1, 0]
+    # as 1 x 1
+    nz, nw = BlockStructure.coerce(aug.blk).shape_M
+    road, u_cmd, x1 = nw, nz, nz + 1
     bound = PeakBound(Channel(outputs=(u_cmd, x1), inputs=(road,)),
                       (float(u_bound) / E, float(z_bound) / E), name="peak u, x1")
     constraints = [bound] + ([] if disk_radius is None else [Disk(radius=float(disk_radius))])
