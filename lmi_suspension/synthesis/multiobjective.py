@@ -333,7 +333,8 @@ def _synthesise(G: GeneralizedPlant, objective, constraints, options, lyapunov_s
         """InfeasibleError if the constraints alone (or constraint ``only`` alone) have no
         strictly feasible point."""
         tried = [largest_margin(only)]
-        if only is not None and _scalable(specs[only - 1]) and not (tried[-1] or 0.0) > _FEASIBLE_MARGIN:
+        met = tried[0] is not None and tried[0] > _FEASIBLE_MARGIN
+        if only is not None and _scalable(specs[only - 1]) and not met:
             # a constraint alone is met by the same controllers at every Lyapunov scale,
             # but the margin is not: on the seat's µ plant the stroke's peak bound (met
             # by the passive seat with 20 % to spare) had margin -1.5e-3 at scale 1 and
