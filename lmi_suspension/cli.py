@@ -194,6 +194,61 @@ def _cmd_design_constrained(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_tradeoff(args: argparse.Namespace) -> int:
+    import json
+    from pathlib import Path
+
+    from .errors import ParameterError
+    from .report.figures import plot_constrained_tradeoff
+    from .seat.constrained import bump_figures, constrained_tradeoff, save_constrained
+    from .seat.design import design_mu_controller
+    from .seat.limit import bump_limit
+    from .seat.roads import bump
+
+    try:
+        bounds = [float(x) for x in args.u_bounds.split(",") if x.strip()]
+    except ValueError as exc:
+        raise ParameterError(f"--u-bounds: expected numbers separated by commas, got "
+                             f"{args.u_bounds!r}") from exc
+    out = Path(args.out)
+    (out / "controllers").mkdir(parents=True, exist_ok=True)
+    bar = _progress_bar(args, len(bounds), "designs")
+
+    def done(point):
+        save_constrained(out / "controllers" / f"mu_constrained_{point.u_bound:g}N.json",
+                         point.design)
+        if bar is not None:
+            bar.update(bounds.index(point.u_bound) + 1)
+        sys.stderr.write(f"{point.u_bound:g} N: µ {point.mu_peak:.4f}, bump peak "
+                         f"{min(point.bump_peak):.2f}–{max(point.bump_peak):.2f} m/s², "
+                         f"commanded ≤ {max(point.bump_u):.0f} N ({point.seconds:.0f} s)\n")
+
+    try:
+        points = constrained_tradeoff(bounds, z_bound=args.z_bound,
+                                      disk_radius=args.disk_radius or None, progress=done)
+    finally:
+        if bar is not None:
+            bar.close()
+    limit = bump_limit(bump()).peak
+    mu = design_mu_controller()
+    ref_peak, ref_u, _x1 = bump_figures(mu.K)
+    fig = plot_constrained_tradeoff(
+        points, limit=limit, reference={f"µ controller (µ {mu.mu_peak:.3f}), clipped at "
+                                        "1500 N": (ref_u, ref_peak)},
+        title="constrained µ-synthesis: force bound against bump peak")
+    fig.savefig(out / "tradeoff.png", dpi=130)
+    table = {"limit": limit, "z_bound": args.z_bound, "disk_radius": args.disk_radius,
+             "points": [p.as_dict() for p in points],
+             "reference": {"mu_peak": mu.mu_peak, "bump_peak": ref_peak, "bump_u": ref_u}}
+    (out / "tradeoff.json").write_text(json.dumps(table, indent=1))
+    for p in points:
+        sys.stdout.write(f"{p.u_bound:8g} N  µ {p.mu_peak:.4f}  worst case {p.u_peak:6.0f} N  "
+                         f"bump peak {max(p.bump_peak):6.2f} m/s² ({max(p.bump_peak) / limit:.2f}"
+                         f" × limit)  commanded {max(p.bump_u):5.0f} N\n")
+    sys.stdout.write(f"written to {out / 'tradeoff.json'} and {out / 'tradeoff.png'}\n")
+    return 0
+
+
 def _cmd_export(args: argparse.Namespace) -> int:
     from pathlib import Path
 
@@ -395,6 +450,19 @@ def build_parser() -> argparse.ArgumentParser:
     p_dc.add_argument("--out", default=None,
                       help="controller file to write (default: the one shipped in the package)")
     p_dc.set_defaults(func=_cmd_design_constrained)
+
+    p_to = sub.add_parser("tradeoff",
+                          help="the force bound's price: one design-constrained per bound "
+                               "(minutes each), simulated on the bump at 0-25 ms; writes "
+                               "tradeoff.json, tradeoff.png and the controllers")
+    p_to.add_argument("--u-bounds", default="2500,3600,6000,9000",
+                      help="force bounds, N, separated by commas")
+    p_to.add_argument("--z-bound", type=float, default=0.16, help="|x1| bound, m")
+    p_to.add_argument("--disk-radius", type=float, default=2000.0,
+                      help="closed-loop poles in |s| < this, rad/s (0: no disk)")
+    p_to.add_argument("--out", default="tradeoff", help="output directory")
+    p_to.add_argument("--quiet", action="store_true", help="no progress bar")
+    p_to.set_defaults(func=_cmd_tradeoff)
 
     p_ex = sub.add_parser("export", help="write a saved controller as a MATLAB .mat file "
                           "(A, B, C, D, InputName, OutputName; Ts when discretised) or JSON")

@@ -95,3 +95,89 @@ def test_bounds_no_controller_meets_are_infeasible():
     # the bump's energy is 6.4 cm)
     with pytest.raises(InfeasibleError):
         design_constrained_mu(1.0, 0.01, disk_radius=None)
+
+
+# --- the trade-off (issue 17, item 6) -------------------------------------------------
+
+@pytest.fixture
+def stand_in_designs(monkeypatch, shipped):
+    """design_constrained_mu replaced by the shipped design at every bound (the real one
+    takes minutes): the trade-off's own work -- the bump simulations -- is what is tested."""
+    import lmi_suspension.seat.constrained as mod
+
+    K, Kd, meta, check = shipped
+    asked = []
+
+    def fake(u_bound, z_bound, **kw):
+        from types import SimpleNamespace
+
+        asked.append((u_bound, z_bound, kw.get("disk_radius")))
+        return mod.ConstrainedMuDesign(
+            K=K, Kd=Kd, musyn=SimpleNamespace(history=(), stop_reason="stand-in"),
+            mu_peak=check.mu_peak, mu_lower_peak=check.mu_lower_peak, u_bound=u_bound,
+            z_bound=z_bound, energy=check.energy, disk_radius=np.inf, u_peak=check.u_peak,
+            x1_peak=check.x1_peak, fastest_pole=check.fastest_pole,
+            controller_fastest_pole=check.controller_fastest_pole, seconds=1.0)
+
+    monkeypatch.setattr(mod, "design_constrained_mu", fake)
+    return K, check, asked
+
+
+def test_tradeoff_simulates_each_design_at_every_delay(stand_in_designs):
+    from lmi_suspension.seat.constrained import constrained_tradeoff
+
+    K, check, asked = stand_in_designs
+    seen = []
+    points = constrained_tradeoff([9000, 3000], z_bound=0.1, disk_radius=None,
+                                  delays=(0.0, 0.025), progress=seen.append)
+    assert asked == [(9000.0, 0.1, None), (3000.0, 0.1, None)]
+    assert [p.u_bound for p in points] == [9000.0, 3000.0] and list(points) == seen
+    # recomputed here by the exact-delay simulator, clipping at the actuator's 1500 N
+    for k, d in enumerate((0.0, 0.025)):
+        run = simulate(K, bump(), delay=d)
+        assert points[0].bump_peak[k] == pytest.approx(run.metrics().peak_z3dd, rel=1e-12)
+        assert points[0].bump_u[k] == pytest.approx(np.max(np.abs(run.u_command)), rel=1e-12)
+        assert points[0].bump_x1[k] == pytest.approx(run.metrics().peak_x1, rel=1e-12)
+    assert points[0].mu_peak == check.mu_peak
+    assert set(points[0].as_dict()) >= {"u_bound", "mu_peak", "bump_peak", "bump_u"}
+
+
+@pytest.mark.parametrize("bounds", [[], [0.0], [np.inf], ["x"], None])
+def test_tradeoff_bad_bounds_are_typed_errors(bounds):
+    from lmi_suspension.seat.constrained import constrained_tradeoff
+
+    with pytest.raises(ParameterError):
+        constrained_tradeoff(bounds)
+
+
+def test_tradeoff_cli_writes_table_figure_and_controllers(stand_in_designs, tmp_path,
+                                                          monkeypatch, capsys):
+    import json
+
+    from matplotlib.image import imread
+
+    import lmi_suspension.seat.design as design_mod
+    from lmi_suspension.cli import main
+    from lmi_suspension.io import load_controller
+
+    K, check, asked = stand_in_designs
+
+    class Mu:  # the µ controller's design (3 s) replaced by a known gain
+        K = control.ss([], [], [], [[-20000.0, 0.0]])
+        mu_peak = 0.9
+
+    monkeypatch.setattr(design_mod, "design_mu_controller", lambda: Mu)
+    assert main(["tradeoff", "--u-bounds", "3000,9000", "--disk-radius", "0", "--out",
+                 str(tmp_path), "--quiet"]) == 0
+    table = json.loads((tmp_path / "tradeoff.json").read_text())
+    assert [p["u_bound"] for p in table["points"]] == [3000.0, 9000.0]
+    assert asked[0][2] is None  # --disk-radius 0: no disk
+    # the limit recomputed by the LP (FACTS.md: 6.164 m/s²)
+    assert table["limit"] == pytest.approx(6.164, abs=1e-3)
+    ref = simulate(Mu.K, bump(), delay=0.0)
+    assert table["reference"]["bump_peak"][0] == pytest.approx(ref.metrics().peak_z3dd)
+    assert imread(tmp_path / "tradeoff.png").shape[0] > 100
+    K_back, meta = load_controller(tmp_path / "controllers" / "mu_constrained_3000N.json")
+    assert np.array_equal(np.asarray(K_back.A), np.asarray(K.A))
+    assert "3000 N" in capsys.readouterr().out
+

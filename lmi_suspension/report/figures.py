@@ -12,7 +12,8 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import NullFormatter
 
-__all__ = ["plot_bounded_response", "plot_force_tradeoff", "plot_mu_bounds",
+__all__ = ["plot_bounded_response", "plot_constrained_tradeoff", "plot_force_tradeoff",
+           "plot_mu_bounds",
            "plot_peak_vs_delay", "plot_responses", "plot_road"]
 
 _LABELS = {
@@ -243,6 +244,71 @@ def plot_force_tradeoff(u_bounds: Sequence[float], hinf: Sequence[float],
         ax.set_xticks(u, [f"{x:g}" for x in u], rotation=60, fontsize=8)
         ax.set_xlabel("force bound $u_{max}$ [N]")
         ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title)
+    return fig
+
+
+def plot_constrained_tradeoff(points: Sequence, *, limit: float,
+                              reference: Mapping[str, tuple] | None = None,
+                              u_actuator: float = 1500.0, goal: float = 1.3,
+                              title: str = "") -> Figure:
+    """The trade-off of the constrained µ designs (issue 17): bump peak against commanded
+    force, and µ against the force bound.
+
+    Parameters
+    ----------
+    points : sequence of TradeoffPoint
+        From :func:`~lmi_suspension.seat.constrained.constrained_tradeoff` (anything with
+        ``u_bound``, ``mu_peak``, ``bump_peak`` and ``bump_u``).
+    limit : float
+        The physical limit of the bump (LP), m/s².
+    reference : mapping, optional
+        Label -> ``(bump_u, bump_peak)`` per delay of other controllers (the µ
+        controller of the paper's weights, say), drawn as single points.
+    u_actuator : float
+        The actuator's force limit, N.
+    goal : float
+        The goal as a multiple of ``limit``.
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as P
+    >>> pts = [P(u_bound=2500.0, mu_peak=2.1, bump_peak=(20.6, 21.9), bump_u=(689.0, 700.0)),
+    ...        P(u_bound=9000.0, mu_peak=2.6, bump_peak=(17.2, 18.0), bump_u=(1038.0, 1096.0))]
+    >>> fig = plot_constrained_tradeoff(pts, limit=6.164, reference={"µ": ((2827.0,), (9.06,))})
+    >>> len(fig.axes)
+    2
+    """
+    order = np.argsort([p.u_bound for p in points])
+    pts = [points[i] for i in order]
+    fig = Figure(figsize=(10, 4), layout="constrained")
+    a1, a2 = fig.subplots(1, 2)
+    u_cmd = np.array([max(p.bump_u) for p in pts])
+    worst = np.array([max(p.bump_peak) for p in pts])
+    best = np.array([min(p.bump_peak) for p in pts])
+    a1.plot(u_cmd, worst, "o-", color="C0", label="constrained µ designs, worst delay")
+    a1.plot(u_cmd, best, "o--", mfc="none", color="C0", label="best delay")
+    for p, x, y in zip(pts, u_cmd, worst):
+        a1.annotate(f"{p.u_bound:g} N", (x, y), textcoords="offset points", xytext=(4, 4),
+                    fontsize=8)
+    for k, (name, (u, peak)) in enumerate((reference or {}).items()):
+        a1.plot([max(u)], [max(peak)], "*", ms=12, color=f"C{k + 3}", label=name)
+    a1.axhline(limit, color="k", lw=2, label=f"physical limit (LP) {limit:.3g} m/s²")
+    a1.axhline(goal * limit, color="k", ls="--", lw=1, label=f"goal {goal:g} × limit")
+    a1.axvline(u_actuator, color="C3", ls=":", label=f"actuator {u_actuator:g} N")
+    a1.set_xlabel("largest commanded $|u|$ on the bump, 0–25 ms [N]")
+    a1.set_ylabel("peak $|\\ddot z_3|$ on the bump [m/s²]")
+    a1.set_ylim(bottom=0)
+    a1.set_xlim(left=0)
+    a2.plot([p.u_bound for p in pts], [p.mu_peak for p in pts], "o-", color="C1",
+            label="µ upper bound (delay cover 0–25 ms)")
+    a2.axhline(1.0, color="k", lw=1, label="µ = 1")
+    a2.set_xlabel("force bound in the K-step (bump's energy) [N]")
+    a2.set_ylabel("µ")
+    a2.set_ylim(bottom=0)
+    for ax in (a1, a2):
+        ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle(title)
     return fig

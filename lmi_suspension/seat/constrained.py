@@ -48,9 +48,10 @@ from .roads import bump
 from .sampled import DEFAULT_SAMPLE_TIME, discretise_controller
 
 __all__ = ["ConstrainedMuDesign", "ConstrainedCheck", "CONSTRAINED_MUSYN",
-           "CONSTRAINED_DESIGN", "CONSTRAINED_OMEGA",
-           "certify_constrained", "design_constrained_mu", "load_constrained",
-           "save_constrained", "SHIPPED_CONTROLLER"]
+           "CONSTRAINED_DESIGN", "CONSTRAINED_OMEGA", "TRADEOFF_DELAYS", "TradeoffPoint",
+           "bump_figures", "certify_constrained", "constrained_tradeoff",
+           "design_constrained_mu", "load_constrained", "save_constrained",
+           "SHIPPED_CONTROLLER"]
 
 #: the constrained design shipped with the package (``lmi-suspension design-constrained``
 #: writes it; ``reproduce`` loads and re-certifies it)
@@ -332,3 +333,128 @@ def load_constrained(path=None) -> tuple:
     K, meta = load_controller(path)
     Kd, _ = load_discrete_controller(path)
     return K, Kd, meta
+
+
+#: the delays, s, at which the trade-off simulates each design on the bump (issue 17)
+TRADEOFF_DELAYS = (0.0, 0.005, 0.01, 0.015, 0.02, 0.025)
+
+
+@dataclass(frozen=True)
+class TradeoffPoint:
+    """One design of :func:`constrained_tradeoff` and what it does on the bump.
+
+    Attributes
+    ----------
+    u_bound : float
+        The force bound asked, N (for every floor velocity of the bump's energy).
+    mu_peak, mu_lower_peak : float
+        µ bounds' peaks of the design (dense grid).
+    u_peak : float
+        Worst-case ``|u|`` over every floor velocity of that energy (closed-loop Gramian).
+    delays : tuple of float
+        Delays of the bump simulations, s.
+    bump_peak, bump_u, bump_x1 : tuple of float
+        Per delay: peak ``|z̈3|`` (m/s²), largest commanded ``|u|`` (N, before the
+        actuator's clipping) and peak ``|x1|`` (m) on the paper's bump, exact delay.
+    seconds : float
+        Design time.
+    design : ConstrainedMuDesign or None
+        The design itself (None when read back from a file).
+    """
+
+    u_bound: float
+    mu_peak: float
+    mu_lower_peak: float
+    u_peak: float
+    delays: tuple
+    bump_peak: tuple
+    bump_u: tuple
+    bump_x1: tuple
+    seconds: float
+    design: ConstrainedMuDesign | None = None
+
+    def as_dict(self) -> dict:
+        """The figures (without the design), for JSON."""
+        return {k: getattr(self, k) for k in ("u_bound", "mu_peak", "mu_lower_peak", "u_peak",
+                                              "delays", "bump_peak", "bump_u", "bump_x1",
+                                              "seconds")}
+
+
+def bump_figures(K, delays=TRADEOFF_DELAYS, params: SeatParameters | None = None
+                 ) -> tuple[tuple, tuple, tuple]:
+    """Peak ``|z̈3|``, largest commanded ``|u|`` and peak ``|x1|`` of a seat controller on
+    the paper's bump at each delay (exact delay, the actuator clipping at
+    ``params.u_max``, as in ``reproduce``).
+
+    Examples
+    --------
+    >>> import control
+    >>> peak, u, x1 = bump_figures(control.ss([], [], [], [[0.0, 0.0]]), delays=(0.0,))
+    >>> round(peak[0], 2), u[0]          # the passive seat (FACTS.md: 26.47 m/s²)
+    (26.47, 0.0)
+    """
+    from .simulate import simulate
+
+    road = bump()
+    runs = [simulate(K, road, delay=float(d), params=params) for d in delays]
+    return (tuple(float(r.metrics().peak_z3dd) for r in runs),
+            tuple(float(np.max(np.abs(r.u_command))) for r in runs),
+            tuple(float(r.metrics().peak_x1) for r in runs))
+
+
+def constrained_tradeoff(u_bounds, *, z_bound: float = 0.16,
+                         disk_radius: float | None = 2000.0, delays=TRADEOFF_DELAYS,
+                         params: SeatParameters | None = None, progress=None,
+                         **design_kw) -> tuple[TradeoffPoint, ...]:
+    """The price of the force bound: one :func:`design_constrained_mu` per bound, each
+    simulated on the bump at every delay.
+
+    Parameters
+    ----------
+    u_bounds : sequence of float
+        Force bounds, N, one design each (minutes per design with the disk).
+    z_bound, disk_radius
+        As in :func:`design_constrained_mu`, the same for every design.
+    delays : sequence of float
+        Delays of the bump simulations, s.
+    params : SeatParameters, optional
+    progress : callable, optional
+        Called with each :class:`TradeoffPoint` as soon as it is complete.
+    **design_kw
+        Further arguments of :func:`design_constrained_mu`.
+
+    Returns
+    -------
+    tuple of TradeoffPoint
+        In the order of ``u_bounds``.
+
+    Raises
+    ------
+    ParameterError
+        An empty or non-positive list of bounds.
+    InfeasibleError
+        A bound no controller meets (with a common Lyapunov matrix).
+    """
+    from ..errors import ParameterError
+
+    try:
+        bounds = [float(u) for u in u_bounds]
+    except (TypeError, ValueError) as exc:
+        raise ParameterError(f"u_bounds must be numbers, got {u_bounds!r}") from exc
+    if not bounds or not all(np.isfinite(u) and u > 0 for u in bounds):
+        raise ParameterError(f"u_bounds must be positive and finite, got {u_bounds!r}")
+    delays = tuple(float(d) for d in delays)
+    points = []
+    for u in bounds:
+        d = design_constrained_mu(u, z_bound, disk_radius=disk_radius, params=params,
+                                  **design_kw)
+        peak, cmd, x1 = bump_figures(d.K, delays, params)
+        point = TradeoffPoint(u_bound=u, mu_peak=d.mu_peak, mu_lower_peak=d.mu_lower_peak,
+                              u_peak=d.u_peak, delays=delays, bump_peak=peak, bump_u=cmd,
+                              bump_x1=x1, seconds=d.seconds, design=d)
+        logger.info("trade-off: bound %g N -> µ %.4f, bump peak %.3f..%.3f m/s², commanded "
+                    "%.0f N", u, d.mu_peak, min(peak), max(peak), max(cmd))
+        points.append(point)
+        if progress is not None:
+            progress(point)
+    return tuple(points)
