@@ -232,14 +232,24 @@ def _cmd_tradeoff(args: argparse.Namespace) -> int:
     limit = bump_limit(bump()).peak
     mu = design_mu_controller()
     ref_peak, ref_u, _x1 = bump_figures(mu.K)
+    passive_peak, passive_u, _x1 = bump_figures(None, delays=(0.0,))
     fig = plot_constrained_tradeoff(
-        points, limit=limit, reference={f"µ controller (µ {mu.mu_peak:.3f}), clipped at "
-                                        "1500 N": (ref_u, ref_peak)},
+        points, limit=limit, reference={
+            f"µ controller (µ {mu.mu_peak:.3f}), clipped at 1500 N": (ref_u, ref_peak),
+            "passive seat": (passive_u, passive_peak)},
         title="constrained µ-synthesis: force bound against bump peak")
     fig.savefig(out / "tradeoff.png", dpi=130)
-    table = {"limit": limit, "z_bound": args.z_bound, "disk_radius": args.disk_radius,
+    from datetime import date
+
+    from . import __version__
+
+    table = {"command": (f"lmi-suspension tradeoff --u-bounds {args.u_bounds} --z-bound "
+                         f"{args.z_bound:g} --disk-radius {args.disk_radius:g}"),
+             "date": date.today().isoformat(), "version": __version__,
+             "limit": limit, "z_bound": args.z_bound, "disk_radius": args.disk_radius,
              "points": [p.as_dict() for p in points],
-             "reference": {"mu_peak": mu.mu_peak, "bump_peak": ref_peak, "bump_u": ref_u}}
+             "reference": {"mu_peak": mu.mu_peak, "bump_peak": ref_peak, "bump_u": ref_u},
+             "passive": {"bump_peak": passive_peak[0]}}
     (out / "tradeoff.json").write_text(json.dumps(table, indent=1))
     for p in points:
         sys.stdout.write(f"{p.u_bound:8g} N  µ {p.mu_peak:.4f}  worst case {p.u_peak:6.0f} N  "

@@ -181,3 +181,20 @@ def test_tradeoff_cli_writes_table_figure_and_controllers(stand_in_designs, tmp_
     assert np.array_equal(np.asarray(K_back.A), np.asarray(K.A))
     assert "3000 N" in capsys.readouterr().out
 
+
+
+def test_shipped_tradeoff_holds_the_shipped_controller(shipped):
+    """The shipped trade-off file (``lmi-suspension tradeoff``, 2026-11-25) against the
+    shipped controller, simulated again here: its 9000 N design is that controller."""
+    from lmi_suspension.seat.constrained import bump_figures, load_tradeoff
+
+    K, Kd, meta, check = shipped
+    points, table = load_tradeoff()
+    assert table["command"].startswith("lmi-suspension tradeoff")
+    same = next(p for p in points if p.u_bound == meta["u_bound"])
+    peak, u_cmd, x1 = bump_figures(K, same.delays)
+    assert same.bump_peak == pytest.approx(peak, rel=1e-6)
+    assert same.bump_u == pytest.approx(u_cmd, rel=1e-6)
+    assert same.mu_peak == pytest.approx(meta["mu_peak_upper"], rel=1e-9)
+    # every point is a design whose bump force stays within the actuator, unclipped
+    assert all(max(p.bump_u) <= 1500.0 for p in points)

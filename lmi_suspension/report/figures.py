@@ -301,15 +301,16 @@ def plot_constrained_tradeoff(points: Sequence, *, limit: float,
     a1.set_ylabel("peak $|\\ddot z_3|$ on the bump [m/s²]")
     a1.set_ylim(bottom=0)
     a1.set_xlim(left=0)
+    a1.legend(fontsize=8, loc="upper right")
     a2.plot([p.u_bound for p in pts], [p.mu_peak for p in pts], "o-", color="C1",
             label="µ upper bound (delay cover 0–25 ms)")
     a2.axhline(1.0, color="k", lw=1, label="µ = 1")
     a2.set_xlabel("force bound in the K-step (bump's energy) [N]")
     a2.set_ylabel("µ")
     a2.set_ylim(bottom=0)
+    a2.legend(fontsize=8)
     for ax in (a1, a2):
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=8)
     fig.suptitle(title)
     return fig
 

@@ -50,8 +50,8 @@ from .sampled import DEFAULT_SAMPLE_TIME, discretise_controller
 __all__ = ["ConstrainedMuDesign", "ConstrainedCheck", "CONSTRAINED_MUSYN",
            "CONSTRAINED_DESIGN", "CONSTRAINED_OMEGA", "TRADEOFF_DELAYS", "TradeoffPoint",
            "bump_figures", "certify_constrained", "constrained_tradeoff",
-           "design_constrained_mu", "load_constrained", "save_constrained",
-           "SHIPPED_CONTROLLER"]
+           "design_constrained_mu", "load_constrained", "load_tradeoff", "save_constrained",
+           "SHIPPED_CONTROLLER", "SHIPPED_TRADEOFF"]
 
 #: the constrained design shipped with the package (``lmi-suspension design-constrained``
 #: writes it; ``reproduce`` loads and re-certifies it)
@@ -87,6 +87,9 @@ CONSTRAINED_DESIGN = replace(DEFAULT_DESIGN, u_max=20000.0)
 #: m/s² on the bump, against µ 2.57, 1038 N and 17.2 m/s² with this one); without the
 #: disk it did better (12.8 against 16.6 m/s² at 0 ms, µ 2.04 against 1.86).
 _LYAPUNOV_SCALES = (1.4e5, 1.0)
+#: the trade-off measured by ``lmi-suspension tradeoff`` (its ``tradeoff.json``; the
+#: command and date are inside), read by :func:`load_tradeoff`
+SHIPPED_TRADEOFF = Path(__file__).parent / "data" / "tradeoff.json"
 
 
 @dataclass(frozen=True)
@@ -458,3 +461,21 @@ def constrained_tradeoff(u_bounds, *, z_bound: float = 0.16,
         if progress is not None:
             progress(point)
     return tuple(points)
+
+
+def load_tradeoff(path=None) -> tuple[tuple[TradeoffPoint, ...], dict]:
+    """The points and the rest of a ``tradeoff.json`` written by ``lmi-suspension
+    tradeoff`` (the shipped measurement by default: :data:`SHIPPED_TRADEOFF`).
+
+    Examples
+    --------
+    >>> points, table = load_tradeoff()
+    >>> table["command"].startswith("lmi-suspension tradeoff")
+    True
+    """
+    import json
+
+    table = json.loads(Path(SHIPPED_TRADEOFF if path is None else path).read_text())
+    points = tuple(TradeoffPoint(**{k: tuple(v) if isinstance(v, list) else v
+                                    for k, v in p.items()}) for p in table["points"])
+    return points, table
