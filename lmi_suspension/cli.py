@@ -196,8 +196,10 @@ def _cmd_design_constrained(args: argparse.Namespace) -> int:
 
 def _cmd_tradeoff(args: argparse.Namespace) -> int:
     import json
+    from datetime import date
     from pathlib import Path
 
+    from . import __version__
     from .errors import ParameterError
     from .report.figures import plot_constrained_tradeoff
     from .seat.constrained import bump_figures, constrained_tradeoff, save_constrained
@@ -239,10 +241,6 @@ def _cmd_tradeoff(args: argparse.Namespace) -> int:
             "passive seat": (passive_u, passive_peak)},
         title="constrained µ-synthesis: force bound against bump peak")
     fig.savefig(out / "tradeoff.png", dpi=130)
-    from datetime import date
-
-    from . import __version__
-
     table = {"command": (f"lmi-suspension tradeoff --u-bounds {args.u_bounds} --z-bound "
                          f"{args.z_bound:g} --disk-radius {args.disk_radius:g}"),
              "date": date.today().isoformat(), "version": __version__,
