@@ -183,6 +183,35 @@ def test_every_reconstruction_failing_is_a_solver_error(monkeypatch):
     assert len(calls) == 3 + 2 * 2
 
 
+def test_an_optimum_no_reconstruction_comes_near_is_not_reported(monkeypatch):
+    """Injected: the reconstruction returns only a controller far above the γ
+    minimisation's optimum.  On a 22-state D-scaled distillation plant the minimisation
+    claimed 0.50004 where Riccati certifies 1.0336 (2026-11-25, /tmp/s5/panic.py in the
+    issue-15 note); such a value is no lower bound, so ``gamma_lower`` is None and the
+    warnings give the claim.  The controller's γ is still the certified one."""
+    import importlib
+
+    mod = importlib.import_module("lmi_suspension.synthesis.hinfsyn")
+    P = scalar_plant(1.0)
+    ref = scalar_gamma_opt(1.0)  # DGKF closed form
+    K = control.ss([], [], [], [[-2.0]])  # u = -2 y: stabilising, far from optimal
+    CL = lft(P, K)
+    gamma_K = float(hinfnorm(CL)[0])
+    relax_max = RELAX * mod._RELAX_GROWTH ** HinfsynOptions().max_recoveries
+    assert gamma_K > ref * (1 + relax_max)  # the premise: beyond every relaxed level
+
+    def far(G, Ps, sc, sols, g_base, fixed, opts, warnings):
+        return (K, CL, gamma_K, np.linalg.eigvals(np.asarray(CL.A)),
+                g_base / sc.gamma_factor, "injected", 1.0, 0.0)
+
+    monkeypatch.setattr(mod, "_reconstruct", far)
+    res = hinfsyn(P, 1, 1)
+    assert res.gamma_lower is None
+    assert any("is not a lower bound" in w and f"{ref:.4g}"[:4] in w for w in res.warnings)
+    assert_certified(res, P)
+    assert res.gamma == pytest.approx(gamma_K, rel=1e-12)
+
+
 def test_frame_is_the_relative_form_of_its_own_solution():
     """A frame built from ``(R, S)`` maps the relative variables ``R̂ = Ŝ = I`` back to
     ``(R, S)`` exactly (the balancing identities of balancing_transform, computed here

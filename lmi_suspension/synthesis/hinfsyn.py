@@ -460,6 +460,8 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
     else:
         Ps, sc = G0, PlantScaling(np.ones(G0.nstates), np.ones(G0.nu), np.ones(G0.ny), 1.0, 1.0)
     t_setup = time.perf_counter() - t0
+    # the γ floor (an optimum of about 0 is designed at gamma_atol), in the plant's units
+    floor = opts.gamma_atol / sc.gamma_factor
     t1 = time.perf_counter()
     fixed = opts.gamma is not None
     if not fixed:
@@ -525,6 +527,16 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
     if gamma_lower is not None and gamma < gamma_lower * (1.0 - opts.gamma_relax):
         warnings.append(f"certified gamma {gamma:.6g} is below the LMI optimum "
                         f"{gamma_lower:.6g}: the γ minimisation was inaccurate")
+    elif gamma_lower is not None and gamma > max(gamma_lower, floor) * (
+            1.0 + opts.gamma_relax * _RELAX_GROWTH ** int(opts.max_recoveries)):
+        # no reconstruction, even at the most relaxed level, came near the claimed
+        # optimum: the γ minimisation's point was not feasible in fact.  Measured on a
+        # 22-state D-scaled distillation plant (poles at -1e-6 rad/s, frames whose sigma
+        # spans 1e14): it claimed 0.50004 where Riccati certifies 1.0336 (2026-11-25)
+        warnings.append(f"the γ minimisation claimed an optimum of {gamma_lower:.6g}, but "
+                        f"no controller reconstructed near it (certified {gamma:.6g}): it "
+                        "is not a lower bound and is not reported")
+        gamma_lower = None
     t_rec = time.perf_counter() - t2 - t_cert - t_refine
     return HinfsynResult(
         K=K, CL=CL, gamma=gamma, gamma_solver=float(level), gamma_lower=gamma_lower,

@@ -146,7 +146,10 @@ class HinfsynResult:
     gamma_lower : float or None
         LMI optimum: no controller of any order achieves less (up to solver accuracy).
         When the returned controller certifies below it, ``warnings`` says that the γ
-        minimisation was inaccurate, and it is no lower bound (COMPleib AC4).
+        minimisation was inaccurate, and it is no lower bound (COMPleib AC4).  None at a
+        fixed ``gamma``, for the Riccati route, and where the certified γ is above even
+        the most relaxed reconstruction level of it (``warnings`` then gives the value
+        the γ minimisation claimed).
     poles : numpy.ndarray
         Closed-loop poles.
     status : str
