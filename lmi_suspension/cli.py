@@ -150,8 +150,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     if args.json:
         data = {"controller": str(path), "realization": realization,
                 "road": road.description, "delay": args.delay,
-                "seed": args.seed, "stable_linear": linear,
-                "peak_u_command": float(abs(res.u_command).max()), **dataclasses.asdict(m)}
+                "seed": args.seed, "stable_linear": linear, **dataclasses.asdict(m)}
         data = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
                 for k, v in data.items()}
         sys.stdout.write(json.dumps(data, indent=1) + "\n")
@@ -162,7 +161,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     rows = [("peak |z3''|", m.peak_z3dd, "m/s^2"), ("RMS z3''", m.rms_z3dd, "m/s^2"),
             ("Wk-weighted RMS z3''", m.weighted_rms_z3dd, "m/s^2"),
             ("VDV", m.vdv_z3dd, "m/s^1.75"), ("peak |x1|", m.peak_x1, "m"),
-            ("peak |u| commanded", float(abs(res.u_command).max()), "N"),
+            ("peak |u| commanded", m.peak_u_command, "N"),
             ("peak |u| applied", m.peak_u, "N"), ("time in saturation", m.saturation_time, "s")]
     for label, value, unit in rows:
         out.write(f"  {label:<22} {value:12.5g} {unit}\n")
@@ -205,6 +204,7 @@ def _cmd_tradeoff(args: argparse.Namespace) -> int:
     from .seat.constrained import bump_figures, constrained_tradeoff, save_constrained
     from .seat.design import design_mu_controller
     from .seat.limit import bump_limit
+    from .seat.params import SeatParameters
     from .seat.roads import bump
 
     try:
@@ -215,12 +215,14 @@ def _cmd_tradeoff(args: argparse.Namespace) -> int:
     out = Path(args.out)
     (out / "controllers").mkdir(parents=True, exist_ok=True)
     bar = _progress_bar(args, len(bounds), "designs")
+    finished = []
 
     def done(point):
         save_constrained(out / "controllers" / f"mu_constrained_{point.u_bound:g}N.json",
                          point.design)
+        finished.append(point)
         if bar is not None:
-            bar.update(bounds.index(point.u_bound) + 1)
+            bar.update(len(finished))
         sys.stderr.write(f"{point.u_bound:g} N: µ {point.mu_peak:.4f}, bump peak "
                          f"{min(point.bump_peak):.2f}–{max(point.bump_peak):.2f} m/s², "
                          f"commanded ≤ {max(point.bump_u):.0f} N ({point.seconds:.0f} s)\n")
@@ -235,9 +237,10 @@ def _cmd_tradeoff(args: argparse.Namespace) -> int:
     mu = design_mu_controller()
     ref_peak, ref_u, _x1 = bump_figures(mu.K)
     passive_peak, passive_u, _x1 = bump_figures(None, delays=(0.0,))
+    u_max = SeatParameters().u_max
     fig = plot_constrained_tradeoff(
-        points, limit=limit, reference={
-            f"µ controller (µ {mu.mu_peak:.3f}), clipped at 1500 N": (ref_u, ref_peak),
+        points, limit=limit, u_actuator=u_max, reference={
+            f"µ controller (µ {mu.mu_peak:.3f}), clipped at {u_max:g} N": (ref_u, ref_peak),
             "passive seat": (passive_u, passive_peak)},
         title="constrained µ-synthesis: force bound against bump peak")
     fig.savefig(out / "tradeoff.png", dpi=130)

@@ -66,9 +66,7 @@ def controller_to_dict(K, *, inputs=None, outputs=None, metadata=None, discrete=
         Kd = discrete
         if not isinstance(Kd, control.StateSpace):
             raise InputError(f"discrete must be a control.StateSpace, got {type(Kd).__name__}")
-        dt = Kd.dt
-        if isinstance(dt, bool) or not (isinstance(dt, (int, float)) and dt > 0):
-            raise InputError(f"discrete must have a positive numeric sample time, got {dt!r}")
+        dt = _sample_time(Kd.dt, "discrete's sample time")
         if (Kd.ninputs, Kd.noutputs) != (K.ninputs, K.noutputs):
             raise DimensionError("the discrete realization must have the controller's "
                                  "inputs and outputs")
@@ -76,7 +74,7 @@ def controller_to_dict(K, *, inputs=None, outputs=None, metadata=None, discrete=
         data.update(Ad=_rows(np.reshape(Kd.A, (nd, nd))),
                     Bd=_rows(np.reshape(Kd.B, (nd, Kd.ninputs))),
                     Cd=_rows(np.reshape(Kd.C, (Kd.noutputs, nd))),
-                    Dd=_rows(np.reshape(Kd.D, (Kd.noutputs, Kd.ninputs))), dt=float(dt))
+                    Dd=_rows(np.reshape(Kd.D, (Kd.noutputs, Kd.ninputs))), dt=dt)
     return data
 
 
@@ -126,10 +124,8 @@ def discrete_from_dict(data: dict) -> control.StateSpace:
     if any(v is None for v in view.values()):
         raise InputError("the discrete realization needs Ad, Bd, Cd, Dd and dt")
     Kd = controller_from_dict(view)
-    dt = data["dt"]
-    if isinstance(dt, bool) or not (isinstance(dt, (int, float)) and dt > 0):
-        raise InputError(f"dt must be a positive number of seconds, got {dt!r}")
-    return control.ss(Kd.A, Kd.B, Kd.C, Kd.D, float(dt), inputs=cont.input_labels,
+    dt = _sample_time(data["dt"], "dt")
+    return control.ss(Kd.A, Kd.B, Kd.C, Kd.D, dt, inputs=cont.input_labels,
                       outputs=cont.output_labels, name="Kd")
 
 
@@ -137,6 +133,14 @@ def load_discrete_controller(path) -> tuple[control.StateSpace, dict]:
     """Read the discrete realization of a controller file (see :func:`discrete_from_dict`)."""
     data = _read(path)
     return discrete_from_dict(data), dict(data.get("metadata", {}))
+
+
+def _sample_time(dt, what: str) -> float:
+    """``dt`` as a positive float of seconds (``True`` and ``None``, python-control's
+    unspecified sample times, are refused)."""
+    if isinstance(dt, bool) or not (isinstance(dt, (int, float)) and dt > 0):
+        raise InputError(f"{what} must be a positive number of seconds, got {dt!r}")
+    return float(dt)
 
 
 def _read(path) -> dict:

@@ -148,6 +148,8 @@ def test_saturation_is_honoured(bump_road):
     assert clipped.any()
     m = res.metrics()
     assert m.peak_u == pytest.approx(200.0)
+    # the command is what the controller asks, before the clipping
+    assert m.peak_u_command == np.max(np.abs(res.u_command)) > 200.0
     assert m.saturation_time == pytest.approx(res.saturated_fraction * res.t[-1])
     # the default limit is params.u_max
     assert simulate(K_SPRING, bump(t_end=0.5)).u_max == SeatParameters().u_max

@@ -12,9 +12,9 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import NullFormatter
 
-__all__ = ["plot_bounded_response", "plot_constrained_tradeoff", "plot_force_tradeoff",
-           "plot_mu_bounds",
-           "plot_peak_vs_delay", "plot_responses", "plot_road"]
+__all__ = ["plot_bounded_response", "plot_commanded_force", "plot_constrained_tradeoff",
+           "plot_force_tradeoff", "plot_mu_bounds", "plot_peak_vs_delay", "plot_responses",
+           "plot_road"]
 
 _LABELS = {
     "z3dd": ("upper-body acceleration $\\ddot z_3$", "m/s²"),

@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 
 import control
@@ -56,6 +56,9 @@ __all__ = ["ConstrainedMuDesign", "ConstrainedCheck", "CONSTRAINED_MUSYN",
 #: the constrained design shipped with the package (``lmi-suspension design-constrained``
 #: writes it; ``reproduce`` loads and re-certifies it)
 SHIPPED_CONTROLLER = Path(__file__).parent / "data" / "mu_constrained.json"
+#: the trade-off measured by ``lmi-suspension tradeoff`` (its ``tradeoff.json``; the
+#: command and date are inside), read by :func:`load_tradeoff`
+SHIPPED_TRADEOFF = Path(__file__).parent / "data" / "tradeoff.json"
 
 logger = logging.getLogger(__name__)
 
@@ -87,9 +90,6 @@ CONSTRAINED_DESIGN = replace(DEFAULT_DESIGN, u_max=20000.0)
 #: m/s² on the bump, against µ 2.57, 1038 N and 17.2 m/s² with this one); without the
 #: disk it did better (12.8 against 16.6 m/s² at 0 ms, µ 2.04 against 1.86).
 _LYAPUNOV_SCALES = (1.4e5, 1.0)
-#: the trade-off measured by ``lmi-suspension tradeoff`` (its ``tradeoff.json``; the
-#: command and date are inside), read by :func:`load_tradeoff`
-SHIPPED_TRADEOFF = Path(__file__).parent / "data" / "tradeoff.json"
 
 
 @dataclass(frozen=True)
@@ -378,9 +378,7 @@ class TradeoffPoint:
 
     def as_dict(self) -> dict:
         """The figures (without the design), for JSON."""
-        return {k: getattr(self, k) for k in ("u_bound", "mu_peak", "mu_lower_peak", "u_peak",
-                                              "delays", "bump_peak", "bump_u", "bump_x1",
-                                              "seconds")}
+        return {f.name: getattr(self, f.name) for f in fields(self) if f.name != "design"}
 
 
 def bump_figures(K, delays=TRADEOFF_DELAYS, params: SeatParameters | None = None
@@ -399,10 +397,9 @@ def bump_figures(K, delays=TRADEOFF_DELAYS, params: SeatParameters | None = None
     from .simulate import simulate
 
     road = bump()
-    runs = [simulate(K, road, delay=float(d), params=params) for d in delays]
-    return (tuple(float(r.metrics().peak_z3dd) for r in runs),
-            tuple(float(np.max(np.abs(r.u_command))) for r in runs),
-            tuple(float(r.metrics().peak_x1) for r in runs))
+    m = [simulate(K, road, delay=float(d), params=params).metrics() for d in delays]
+    return (tuple(r.peak_z3dd for r in m), tuple(r.peak_u_command for r in m),
+            tuple(r.peak_x1 for r in m))
 
 
 def constrained_tradeoff(u_bounds, *, z_bound: float = 0.16,

@@ -65,6 +65,9 @@ class SimulationMetrics:
         The deflection limit used, m.
     peak_u : float
         Peak applied force ``|u_applied|``, N.
+    peak_u_command : float
+        Peak commanded force ``|u_command|``, N (before the delay and the clipping: above
+        ``u_max`` the actuator clips and the loop is not the linear one designed).
     saturation_time : float
         Time spent in saturation, s.
     stable : bool
@@ -79,6 +82,7 @@ class SimulationMetrics:
     x1_within_limit: bool
     z_max: float
     peak_u: float
+    peak_u_command: float
     saturation_time: float
     stable: bool
 
@@ -156,6 +160,7 @@ class SimulationResult:
             x1_within_limit=bool(peak_x1 <= z_max),
             z_max=z_max,
             peak_u=float(np.max(np.abs(self.u_applied))),
+            peak_u_command=float(np.max(np.abs(self.u_command))),
             saturation_time=float(self.saturated_fraction * (self.t[-1] - self.t[0])),
             stable=self.stable,
         )
