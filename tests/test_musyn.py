@@ -406,3 +406,48 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
                           mu1.d_blocks, None, 0, kstep) is None
     assert search_dscales(ex.P, ex.nmeas, ex.ncon, [(1, 1), (1, 1), (2, 2)], w,
                           np.ones((3, w.size)), None, 4, kstep) is None
+
+
+def test_initial_controller_takes_the_place_of_the_first_k_step():
+    """``K0``: iteration 1 is that controller, certified on the plant, and D-K goes on
+    from its D-step.  Its norm and µ peak are recomputed here from the closed loop."""
+    from lmi_suspension.synthesis import HinfsynOptions
+
+    ex, w = skogestad_distillation(), np.logspace(-3, 3, 61)
+    K0 = hinfsyn(ex.P, 2, 2, method="riccati",
+                 options=HinfsynOptions(riccati_search="bisection")).K
+    res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=w, K0=K0,
+                options=MusynOptions(method="riccati", max_iter=2, patience=2,
+                                     dscale_search=0))
+    first = res.history[0]
+    for name in "ABCD":
+        assert np.array_equal(getattr(first.K, name), getattr(K0, name))
+    assert any("K0" in note for note in first.warnings)
+    CL = lft(ex.P, K0)
+    dense = np.logspace(-3, 3, 4001)
+    grid_peak = np.linalg.norm(np.moveaxis(freqresp(CL, dense), -1, 0), 2, axis=(1, 2)).max()
+    assert grid_peak * (1 - 1e-9) <= first.gamma <= grid_peak * 1.01
+    mu = mussv(freqresp(CL, w), ex.blk)
+    assert first.mu_peak == pytest.approx(np.max(mu.upper), rel=1e-6)
+    assert len(res.history) == 2 and res.history[1].gamma_prev > 0
+    assert res.history[1].seconds_k > first.seconds_k
+
+
+def test_initial_controller_is_checked():
+    from lmi_suspension.errors import DiscreteTimeError, NonFiniteError
+
+    ex = skogestad_distillation()
+    run = lambda K0: musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, K0=K0,  # noqa: E731
+                           options=MusynOptions(max_iter=1, dscale_search=0))
+    with pytest.raises(DimensionError, match="K0"):
+        run(np.zeros((2, 3)))
+    with pytest.raises(DiscreteTimeError):
+        run(control.ss([], [], [], np.zeros((2, 2)), 0.1))
+    with pytest.raises(NonFiniteError):
+        run(np.full((2, 2), np.nan))
+    # a static gain that destabilises the loop, found (and checked) here
+    unstable = [c for c in (10.0, -10.0, 100.0, -100.0)
+                if np.max(np.real(lft(ex.P, c * np.eye(2)).poles())) > 0]
+    assert unstable
+    with pytest.raises(ParameterError, match="does not stabilise"):
+        run(unstable[0] * np.eye(2))

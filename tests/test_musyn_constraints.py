@@ -123,3 +123,21 @@ def test_constraints_no_controller_meets_together_are_infeasible():
     with pytest.raises(InfeasibleError):
         musyn(P, 1, 1, BLK, omega=OMEGA, options=OPTIONS,
               constraints=[PeakBound(FORCE, (1e-6,)), HalfPlane(alpha=10.0)])
+
+
+def test_initial_controller_must_meet_the_constraints():
+    # u = k y moves the plant's pole to -1 + 2k (computed here from the closed loop)
+    P, region = _plant(), HalfPlane(alpha=3.0)
+    for k in (-0.5, -2.0):
+        assert np.linalg.eigvals(np.asarray(lft(P, [[k]], 1, 1).A))[0] == \
+            pytest.approx(-1.0 + 2.0 * k)
+    with pytest.raises(ParameterError, match="K0 violates"):
+        musyn(P, 1, 1, BLK, omega=OMEGA, options=OPTIONS, constraints=[region],
+              K0=[[-0.5]])
+    res = musyn(P, 1, 1, BLK, omega=OMEGA, options=OPTIONS, constraints=[region],
+                K0=[[-2.0]])
+    assert np.array_equal(res.history[0].K.D, [[-2.0]])
+    assert res.history[0].certificates[0].met
+    for it in res.history:
+        poles = np.linalg.eigvals(np.asarray(lft(P, it.K, 1, 1).A))
+        assert np.all(poles.real < -3.0)
