@@ -652,3 +652,72 @@ def test_frame_rounds_find_the_optimum_the_first_minimisation_misses():
     assert lmi.gamma <= ric.gamma * 1.005  # 1.1657 and 1.1661, measured
     plain = hinfsyn(PD, nmeas, ncon, options=HinfsynOptions(scale=False))
     assert plain.gamma == pytest.approx(lmi.gamma, rel=5e-3)
+
+
+def test_riccati_frame_comes_from_lmi_solutions():
+    """The frame of the Riccati solutions at an achievable level is the balancing frame
+    of ``R = γ X∞⁻¹``, ``S = γ Y∞⁻¹``; those satisfy the textbook projected inequalities
+    of Gahinet & Apkarian (1994, Thm 4.3) at that level and their coupling (checked here
+    with scipy's null-space bases and numpy eigenvalues).  Level: 1.2 times the
+    certified Riccati γ of the D-scaled distillation plant."""
+    import scipy.linalg
+
+    from lmi_suspension.lti.scaling import scale_plant
+    from lmi_suspension.synthesis.lmi import riccati_frame
+
+    PD, nmeas, ncon, ric = _distillation_with_dscale(0.3)
+    Ps, sc = scale_plant(GeneralizedPlant.from_statespace(PD, nmeas, ncon))
+    g = 1.2 * ric.gamma * sc.gamma_factor
+    frame = riccati_frame(Ps, g)
+    assert frame is not None
+    R, S = frame.lyapunov(np.eye(Ps.nstates), np.eye(Ps.nstates))
+    b = Ps.blocks()
+    A, B1, B2, C1, C2 = b["A"], b["B1"], b["B2"], b["C1"], b["C2"]
+    D11, D12, D21 = b["D11"], b["D12"], b["D21"]
+    nz, nw = D11.shape
+    NR = scipy.linalg.block_diag(scipy.linalg.null_space(np.hstack([B2.T, D12.T])),
+                                 np.eye(nw))
+    MR = np.block([[A @ R + R @ A.T, R @ C1.T, B1],
+                   [C1 @ R, -g * np.eye(nz), D11],
+                   [B1.T, D11.T, -g * np.eye(nw)]])
+    NS = scipy.linalg.block_diag(scipy.linalg.null_space(np.hstack([C2, D21])), np.eye(nz))
+    MS = np.block([[A.T @ S + S @ A, S @ B1, C1.T],
+                   [B1.T @ S, -g * np.eye(nw), D11.T],
+                   [C1, D11, -g * np.eye(nz)]])
+    for N, M in ((NR, MR), (NS, MS)):
+        L = N.T @ M @ N
+        assert np.linalg.eigvalsh((L + L.T) / 2)[-1] <= 1e-6 * np.abs(L).max()
+    n = Ps.nstates
+    coupling = np.block([[R, np.eye(n)], [np.eye(n), S]])
+    assert np.linalg.eigvalsh(coupling)[0] >= -1e-8 * np.abs(coupling).max()
+    # below the optimum the coupling fails: no frame
+    assert riccati_frame(Ps, 0.9 * ric.gamma * sc.gamma_factor) is None
+
+
+def test_level_hint_starts_the_gamma_minimisation_in_the_riccati_frame(monkeypatch):
+    """A level some controller achieves (here the certified Riccati γ) starts the LMI
+    route's γ minimisation in the frame of the Riccati solutions; where the solve fails
+    there (injected), the identity frame takes over.  Both certify within 0.5 % of
+    Riccati (S&P distillation plant with a (0.3 s + 1)/(s + 1) D-scale, as above)."""
+    PD, nmeas, ncon, ric = _distillation_with_dscale(0.3)
+    hinted = _hinfsyn(PD, nmeas, ncon, level_hint=ric.gamma)
+    assert_certified(hinted, PD)
+    assert any("frame of the Riccati solutions" in w for w in hinted.warnings)
+    assert hinted.gamma <= ric.gamma * 1.005
+
+    real = _lmi.gamma_lmi
+    calls = []
+
+    def failing_in_a_frame(P, opts, gamma=None, frame=None):
+        calls.append(frame)
+        if len(calls) == 1:
+            assert frame is not None  # the Riccati frame comes first
+            raise SolverError("injected")
+        return real(P, opts, gamma, frame)
+
+    monkeypatch.setattr(_lmi, "gamma_lmi", failing_in_a_frame)
+    fallback = _hinfsyn(PD, nmeas, ncon, level_hint=ric.gamma)
+    assert calls[1] is None  # then the identity frame
+    assert any("Riccati frame failed" in w for w in fallback.warnings)
+    assert_certified(fallback, PD)
+    assert fallback.gamma <= ric.gamma * 1.005

@@ -451,3 +451,35 @@ def test_initial_controller_is_checked():
     assert unstable
     with pytest.raises(ParameterError, match="does not stabilise"):
         run(unstable[0] * np.eye(2))
+
+
+def test_a_k_step_failing_on_an_over_relaxed_plant_retries_on_the_plain_one(monkeypatch):
+    """Injected: the K-step of iteration 3 (whose plant comes from an over-relaxed
+    D-step, iteration 2 being the best) fails once; D-K goes on with the plain D-step's
+    plant of the same iteration instead of stopping.  The retry's reference level is
+    recomputed here on that plant."""
+    import lmi_suspension.mu.dk as dk
+    from lmi_suspension.errors import SolverError
+
+    ex = skogestad_distillation()
+    real, plants = dk._k_step, []
+
+    def k_step(hinfsyn, PD, nmeas, ncon, opts, gamma_prev=float("nan")):
+        plants.append((PD, gamma_prev))
+        if len(plants) == 3:
+            raise SolverError("injected")
+        return real(hinfsyn, PD, nmeas, ncon, opts, gamma_prev)
+
+    monkeypatch.setattr(dk, "_k_step", k_step)
+    res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-3, 3, 61),
+                options=MusynOptions(method="riccati", max_iter=3, patience=3,
+                                     dscale_search=0))
+    assert res.history[1].mu_peak < res.history[0].mu_peak  # iteration 2 was the best
+    assert len(plants) == 4 and len(res.history) == 3
+    assert "K-step failed" not in res.stop_reason
+    (failed, _), (retried, gamma_prev) = plants[2], plants[3]
+    assert failed.nstates != retried.nstates or not np.allclose(failed.A, retried.A)
+    K2 = res.history[1].K
+    CL = lft(retried, K2, ex.nmeas, ex.ncon)
+    assert gamma_prev == pytest.approx(float(hinfnorm(CL)[0]), rel=1e-6)
+    assert res.history[2].gamma_prev == gamma_prev

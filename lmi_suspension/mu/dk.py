@@ -17,6 +17,7 @@ the returned µ bounds use the true mixed structure.
 
 from __future__ import annotations
 
+import functools
 import logging
 import time
 import warnings
@@ -535,6 +536,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     relax = _OverRelaxation(float(opts.dscale_overrelax))
     gamma_next = None  # K_prev's norm on the next scaled plant, when the D-step has it
     scales = lyapunov_scales  # the constrained K-step's, searched once, then reused
+    plain_next = None  # the plain D-step's (fit, plant) when the next plant is over-relaxed
     for it in range(1, int(opts.max_iter) + 1):
         t0 = time.perf_counter()
         # what the previous controller achieves on the new scaled plant (computed by the
@@ -545,21 +547,42 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
             gamma_prev = (float(hinfnorm(_mu_part(lft(PD, K_prev, nmeas, ncon), struct))[0])
                           if K_prev is not None else float("nan"))
         gamma_next = None
-        try:
-            if it == 1 and given is not None:
-                syn = given
-            elif constraints:
-                syn = _constrained_k_step(PD, nmeas, ncon, opts, struct, constraints,
-                                          scales)
-                scales = syn.lyapunov_scales
-            else:
-                syn = _k_step(hinfsyn, PD, nmeas, ncon, opts, gamma_prev)
-        except LmiSuspensionError as exc:
-            if best is None:
-                raise
-            stop_reason = f"K-step failed at iteration {it}: {exc}"
+        syn, failure = None, None
+        while syn is None:
+            try:
+                if it == 1 and given is not None:
+                    syn = given
+                elif constraints:
+                    syn = _constrained_k_step(PD, nmeas, ncon, opts, struct, constraints,
+                                              scales)
+                    scales = syn.lyapunov_scales
+                else:
+                    syn = _k_step(hinfsyn, PD, nmeas, ncon, opts, gamma_prev)
+            except LmiSuspensionError as exc:
+                if best is None:
+                    raise
+                if plain_next is None:
+                    failure = exc
+                    break
+                # an over-relaxed plant the K-step cannot handle (distillation: a
+                # controller LMI that failed at every level on the plant of iteration 3,
+                # 2026-11-25): the plain D-step's plant instead, once
+                logger.info("musyn: K-step failed on the over-relaxed plant of iteration "
+                            "%d (%s); plain D-step instead", it, exc)
+                try:
+                    dfit, PD = plain_next()
+                except LmiSuspensionError as fit_exc:
+                    failure = fit_exc
+                    break
+                plain_next = None
+                relax.fitted(_fit_magnitudes(dfit, omega))
+                gamma_prev = float(hinfnorm(_mu_part(lft(PD, K_prev, nmeas, ncon),
+                                                     struct))[0])
+        if failure is not None:
+            stop_reason = f"K-step failed at iteration {it}: {failure}"
             logger.warning("musyn: %s; keeping iteration %d", stop_reason, best[2])
             break
+        plain_next = None
         K = syn.K
         t1 = time.perf_counter()
         CL_full = lft(G, K)
@@ -653,6 +676,8 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
                         dfit, PD_next = scaled(d_plain)
                         gamma_next = None
                 PD = PD_next
+                if d_target is not d_plain and gamma_next is not None:
+                    plain_next = functools.partial(scaled, d_plain)
                 orders = tuple(max(o) for o in dfit.orders)
                 relax.fitted(_fit_magnitudes(dfit, omega))
             except LmiSuspensionError as exc:
@@ -970,7 +995,9 @@ def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
             else HinfsynOptions(riccati_search="bisection"))
     probes = KSTEP_RICCATI_PROBES  # used by the Riccati route only
     if opts.method != "best":
-        return hinfsyn(PD, nmeas, ncon, method=opts.method, options=base, probes=probes)
+        hint = gamma_prev if opts.method == "lmi" and np.isfinite(gamma_prev) else None
+        return hinfsyn(PD, nmeas, ncon, method=opts.method, options=base, probes=probes,
+                       level_hint=hint)
     results, errors = [], []
 
     def previous_beaten() -> bool:

@@ -32,6 +32,12 @@ _CENTER_TRACE = 10.0
 _RELAX_GROWTH = 4.0
 #: bound on the refinements started by a controller that beats the LMI optimum
 _FORCED_PASSES = 3
+#: levels, relative to a level hint, at which the Riccati frame is tried in turn: at the
+#: hint itself (an achievable level, possibly the optimum) the Hamiltonians can be too
+#: close to the imaginary axis for the Riccati solver, and on a 22-state D-scaled
+#: distillation plant scipy's reordering failed at 1.01 and 1.05 times the hint and
+#: succeeded at 1.2 (measured 2026-11-25)
+_HINT_LEVELS = (1.01, 1.2, 2.0)
 #: the cap of the second frame the controller LMI is tried in.  On a 22-state D-K plant
 #: of the distillation problem (sigma up to 2.5e8) the controller LMI failed in the full
 #: frame (scalings up to 1.6e4 apart) and certified 1.03321 against an LMI optimum of
@@ -162,13 +168,17 @@ def hinfsyn(P, nmeas: int, ncon: int, *, method: str = "lmi",
 
 def _hinfsyn(P, nmeas: int, ncon: int, method: str = "lmi",
              options: HinfsynOptions | None = None, *, probes: tuple = (),
-             bracket: tuple | None = None) -> HinfsynResult:
+             bracket: tuple | None = None, level_hint: float | None = None
+             ) -> HinfsynResult:
     """:func:`hinfsyn` with the Riccati route's search heuristics that ``musyn`` uses:
     ``probes``, relative levels ``(1 + r) γ`` whose suboptimal controllers are also
     certified when the γ-optimal one certifies above its own γ (the formulas are
     ill-conditioned at the optimum), and ``bracket``, the ``(lo, hi)`` levels the
     ``"bisection"`` search starts from (checked and widened by factors of 4 where
-    wrong)."""
+    wrong), and ``level_hint``, a level some controller is known to achieve (in D-K,
+    the previous controller's on the new scaled plant): the LMI route's γ
+    minimisation then starts in the frame of the Riccati solutions at that level
+    (:func:`~lmi_suspension.synthesis.lmi.riccati_frame`)."""
     opts = HinfsynOptions() if options is None else options
     if not isinstance(opts, HinfsynOptions):
         raise ParameterError("options must be a HinfsynOptions instance")
@@ -190,7 +200,7 @@ def _hinfsyn(P, nmeas: int, ncon: int, method: str = "lmi",
         raise ParameterError(f"probes must be positive relative steps, got {probes!r}")
     if method == "riccati":
         return _hinfsyn_riccati(G, opts, t0, tuple(probes), bracket)
-    return _hinfsyn_lmi(G, opts, t0)
+    return _hinfsyn_lmi(G, opts, t0, level_hint)
 
 
 # --------------------------------------------------------------------------- riccati
@@ -408,7 +418,8 @@ def _unit_gamma(Ps: GeneralizedPlant, sc: PlantScaling, g: float, sols: list):
 
 
 def _refined_gamma_lmi(Ps: GeneralizedPlant, opts: HinfsynOptions,
-                       sol: "_lmi.LmiSolution | None" = None
+                       sol: "_lmi.LmiSolution | None" = None, *,
+                       start: "_lmi.Frame | None" = None
                        ) -> tuple["_lmi.LmiSolution", list]:
     """The γ minimisation, repeated in the frame of its own solution while that solution
     is not clean (:attr:`~lmi_suspension.synthesis.lmi.LmiSolution.clean`) and the
@@ -421,13 +432,21 @@ def _refined_gamma_lmi(Ps: GeneralizedPlant, opts: HinfsynOptions,
     with the solution (201978, 315, 2.30, 1.2016, 1.2005, measured 2026-11-25).  Only
     decreases are kept: a round that stops higher ends the refinement.  Given a ``sol``
     (a minimisation that looked clean but that a certified controller has beaten), at
-    least one round is made from it.
+    least one round is made from it.  A ``start`` frame (:func:`~.lmi.riccati_frame`)
+    is where the first minimisation is posed; where it fails there, the identity frame.
 
     Returns the last solution and the earlier ones, oldest first.
     """
     forced = sol is not None
-    sol = _lmi.gamma_lmi(Ps, opts) if sol is None else sol
     notes: list[str] = []
+    if sol is None and start is not None:
+        try:
+            sol = _lmi.gamma_lmi(Ps, opts, frame=start)
+            notes.append("γ minimisation started in the frame of the Riccati solutions")
+        except (SolverError, InfeasibleError) as exc:
+            notes.append(f"γ minimisation in the Riccati frame failed ({exc}); identity "
+                         "frame")
+    sol = _lmi.gamma_lmi(Ps, opts) if sol is None else sol
     earlier: list = []
     for k in range(_FRAME_ROUNDS):
         if (sol.clean and not (forced and k == 0)) or Ps.nstates == 0:
@@ -452,7 +471,8 @@ def _refined_gamma_lmi(Ps: GeneralizedPlant, opts: HinfsynOptions,
     return replace(sol, warnings=sol.warnings + tuple(notes)), earlier
 
 
-def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> HinfsynResult:
+def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float,
+                 level_hint: float | None = None) -> HinfsynResult:
     warnings: list[str] = []
     G0 = _without_d22(G)
     if opts.scale:
@@ -465,7 +485,13 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float) -> Hinfsy
     t1 = time.perf_counter()
     fixed = opts.gamma is not None
     if not fixed:
-        sol, earlier = _refined_gamma_lmi(Ps, opts)
+        start = None
+        if level_hint is not None and np.isfinite(level_hint) and level_hint > 0:
+            for factor in _HINT_LEVELS:
+                start = _lmi.riccati_frame(Ps, float(level_hint) * sc.gamma_factor * factor)
+                if start is not None:
+                    break
+        sol, earlier = _refined_gamma_lmi(Ps, opts, start=start)
         gamma_lower: float | None = sol.gamma / sc.gamma_factor
         if opts.gamma_abort is not None and gamma_lower > opts.gamma_abort:
             raise SolverError(f"the γ minimisation stopped at {gamma_lower:.6g}, above the "
