@@ -483,3 +483,31 @@ def test_a_k_step_failing_on_an_over_relaxed_plant_retries_on_the_plain_one(monk
     CL = lft(retried, K2, ex.nmeas, ex.ncon)
     assert gamma_prev == pytest.approx(float(hinfnorm(CL)[0]), rel=1e-6)
     assert res.history[2].gamma_prev == gamma_prev
+
+
+def test_lmi_k_step_knows_the_previous_controllers_level():
+    """The LMI K-step gets the previous controller's level on the new scaled plant as
+    its Riccati-frame hint and as the level above which its γ minimisation has failed
+    (gamma_abort, with the K-step's 0.1 % slack); the first K-step has neither, and a
+    user's own gamma_abort or fixed γ is kept."""
+    from lmi_suspension.mu.dk import _k_step
+    from lmi_suspension.synthesis import HinfsynOptions
+
+    seen = []
+
+    def fake(PD, nmeas, ncon, method, options, probes, level_hint=None):
+        seen.append((method, options, level_hint))
+        return "result"
+
+    P = skogestad_distillation().P
+    assert _k_step(fake, P, 2, 2, MusynOptions(), 1.25) == "result"
+    method, options, hint = seen[-1]
+    assert (method, hint) == ("lmi", 1.25)
+    assert options.gamma_abort == pytest.approx(1.25 * 1.001)
+    _k_step(fake, P, 2, 2, MusynOptions(), float("nan"))
+    assert seen[-1][1].gamma_abort is None and seen[-1][2] is None
+    own = HinfsynOptions(gamma_abort=9.0)
+    _k_step(fake, P, 2, 2, MusynOptions(hinfsyn_options=own), 1.25)
+    assert seen[-1][1].gamma_abort == 9.0
+    _k_step(fake, P, 2, 2, MusynOptions(method="riccati"), 1.25)
+    assert seen[-1][2] is None and seen[-1][1].gamma_abort is None
