@@ -511,3 +511,29 @@ def test_lmi_k_step_knows_the_previous_controllers_level():
     assert seen[-1][1].gamma_abort == 9.0
     _k_step(fake, P, 2, 2, MusynOptions(method="riccati"), 1.25)
     assert seen[-1][2] is None and seen[-1][1].gamma_abort is None
+
+
+def test_a_plain_rebuild_is_not_repeated_by_a_restart():
+    """After the K-step fell back to iterate 2's plain D-step (plain_from), an iterate 3
+    that is not the best continues from itself: restarting from iterate 2 would rebuild
+    the very plant iterate 3 was designed on."""
+    from lmi_suspension.mu.dk import _DStep, _OverRelaxation
+
+    relax = _OverRelaxation(2.0)
+    step = lambda k: _DStep(M=None, d_blocks=[np.full(3, float(k))],  # noqa: E731
+                            upper=np.ones(3), mu_peak=1.0, K=None)
+    relax.step(1, 1, step(1))
+    relax.fitted([np.ones(3)])
+    relax.step(2, 2, step(2))  # the best: an over-relaxed target
+    relax.plain_from(2)
+    here = step(3)
+    source, target = relax.step(3, 2, here)
+    assert source is here and target is here.d_blocks
+    # without the fallback, the same iterate restarts from the best one
+    fresh = _OverRelaxation(2.0)
+    fresh.step(1, 1, step(1))
+    fresh.fitted([np.ones(3)])
+    best = step(2)
+    fresh.step(2, 2, best)
+    source, _ = fresh.step(3, 2, step(3))
+    assert source is best

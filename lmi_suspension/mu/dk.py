@@ -395,6 +395,12 @@ class _OverRelaxation:
                     "over-relaxation %.3g", it, best_it, self.alpha)
         return self._best, self._best.d_blocks
 
+    def plain_from(self, it: int) -> None:
+        """The next plant was rebuilt from iterate ``it``'s plain D-step (its K-step
+        failed on the over-relaxed one): what a restart from ``it`` would build, so a
+        restart is not repeated after it."""
+        self._restarted_from = it
+
     def fitted(self, magnitudes: list[np.ndarray]) -> None:
         """Record the fit the next scaled plant was built with."""
         self._fit_mag = magnitudes
@@ -576,6 +582,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
                     break
                 plain_next = None
                 relax.fitted(_fit_magnitudes(dfit, omega))
+                relax.plain_from(it - 1)
                 gamma_prev = float(hinfnorm(_mu_part(lft(PD, K_prev, nmeas, ncon),
                                                      struct))[0])
         if failure is not None:
