@@ -75,7 +75,11 @@ class MusynOptions:
         route (abandoned when its γ minimisation stops above
         twice a certified Riccati γ, and skipped on scaled plants of more than 30 states
         once Riccati has a controller), and keeps the controller with the lowest
-        certified closed-loop γ.
+        certified closed-loop γ.  From the second iteration on, the LMI K-step knows
+        the previous controller's level on the new scaled plant: its γ minimisation
+        starts in the frame of the Riccati solutions at that level and gives up where
+        it stops above it (``gamma_abort``, unless the options set one); where it fails
+        on an over-relaxed plant, the plain D-step's plant is used instead.
     hinfsyn_options : HinfsynOptions or None
         Options passed to every K-step (default: ``HinfsynOptions`` with
         ``riccati_search = "bisection"``; the Riccati K-steps also try the suboptimal
