@@ -400,3 +400,54 @@ def test_bad_input_fit_dscales_and_scaled_plant():
         scaled_plant(control.ss(P.A, P.B, P.C, np.full(P.D.shape, np.nan)), 1, 1, dfit,
                      [(1, 1), (1, 1)])
     assert issubclass(NonFiniteError, LmiSuspensionError)
+
+
+def _plant_with_a_hidden_state(rng):
+    """A random plant plus one state that no input reaches: minreal may drop it."""
+    P = _random_plant(rng, 3, 2, 1, 2, 1)
+    A = np.zeros((4, 4))
+    A[:3, :3], A[3, 3] = P.A, -2.0
+    B = np.vstack([P.B, np.zeros((1, P.ninputs))])
+    C = np.hstack([P.C, rng.normal(size=(P.noutputs, 1))])
+    return control.ss(A, B, C, P.D)
+
+
+def _pointwise(P, dfit, wt):
+    d = resp(dfit.fits[0], wt)[:, 0, 0]
+    one = np.ones_like(d)
+    left = np.array([d, one, one]).T  # z1 scaled by d, z2 (performance) and y by 1
+    return resp(P, wt) * left[:, :, None] / left[:, None, :]
+
+
+def test_scaled_plant_keeps_an_exact_reduction():
+    """minreal's realization stands in for the series connection where their responses
+    agree: here it removes the plant's unreachable state and nothing else."""
+    P = _plant_with_a_hidden_state(np.random.default_rng(21))
+    dfit = fit_dscales(W, [np.abs(control.tf([1, 3], [1, 0.5])(1j * W)), np.ones_like(W)],
+                       rtol=1e-4)
+    PD = scaled_plant(P, 1, 1, dfit, [(1, 1), (1, 1)])
+    n_series = P.nstates + 2 * dfit.fits[0].nstates
+    assert PD.nstates == n_series - 1
+    wt = np.logspace(-2, 2, 9)
+    np.testing.assert_allclose(resp(PD, wt), _pointwise(P, dfit, wt), rtol=1e-8)
+
+
+def test_scaled_plant_refuses_a_reduction_that_changes_the_response(monkeypatch):
+    """A minimal realization that is not the same system (SLICOT's rank decisions on a
+    22-state D-scaled distillation plant dropped four controllable, observable states,
+    and the response moved by 66 % below 0.1 rad/s) is replaced by the series
+    connection.  The failure is injected: a minreal that drops the last state."""
+    from lmi_suspension.mu import dfit as dfit_module
+
+    P = _random_plant(np.random.default_rng(22), 3, 2, 1, 2, 1)
+    dfit = fit_dscales(W, [np.abs(control.tf([1, 3], [1, 0.5])(1j * W)), np.ones_like(W)],
+                       rtol=1e-4)
+
+    def dropping_minreal(sys, tol=None, verbose=False):
+        return control.ss(sys.A[:-1, :-1], sys.B[:-1], sys.C[:, :-1], sys.D)
+
+    monkeypatch.setattr(dfit_module.control, "minreal", dropping_minreal)
+    PD = scaled_plant(P, 1, 1, dfit, [(1, 1), (1, 1)])
+    assert PD.nstates == P.nstates + 2 * dfit.fits[0].nstates
+    wt = np.logspace(-2, 2, 9)
+    np.testing.assert_allclose(resp(PD, wt), _pointwise(P, dfit, wt), rtol=1e-8)
