@@ -537,3 +537,25 @@ def test_a_plain_rebuild_is_not_repeated_by_a_restart():
     fresh.step(2, 2, best)
     source, _ = fresh.step(3, 2, step(3))
     assert source is best
+
+
+def test_an_iterate_whose_mu_lower_bound_beats_its_gamma_is_flagged(monkeypatch):
+    """µ's lower bound cannot exceed the γ certified on a scaled plant (any D of the
+    commuting structure bounds µ from above).  A certificate made wrong on purpose, a
+    D-scale search whose norms are halved, must show in the record as a warning; the
+    true iterates of the same run carry none."""
+    from lmi_suspension.mu import dsearch
+
+    real = dsearch.hinfnorm
+    monkeypatch.setattr(dsearch, "hinfnorm", lambda sys: (0.5 * real(sys)[0], 0.0))
+    ex = skogestad_distillation()
+    res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-3, 3, 31),
+                options=MusynOptions(method="riccati", max_iter=1, dscale_search=3))
+    *loop, search = res.history
+    assert search.stage == "dscale_search"
+    assert search.mu_lower_peak > search.gamma * 1.5  # halved γ, true µ
+    assert any("exceeds the certified γ" in w for w in search.warnings)
+    assert all(h.mu_lower_peak <= h.gamma * (1 + 1e-3) for h in loop)
+    assert not any("exceeds the certified γ" in w for h in loop for w in h.warnings)
+    # what musyn reports for it is µ of its own loop, not the wrong γ
+    assert res.mu_peak >= search.mu_lower_peak * (1 - 1e-3) > search.gamma

@@ -50,6 +50,23 @@ _LMI_FALLBACK_MAX_STATES = 30
 #: an over-relaxed D-fit whose scaled loop (previous controller) peaks this much above its
 #: grid value is replaced by the plain one
 _OFFGRID_RTOL = 0.05
+#: slack of the check µ lower bound <= certified γ of an iterate (the µ bounds are
+#: computed to about 1e-4 on the grid, and γ to 1e-9 by hinfnorm)
+_BOUNDS_RTOL = 1e-3
+
+
+def _bound_check(gamma: float, mu_lower: float, what: str) -> tuple[str, ...]:
+    """A warning where the µ lower bound of an iterate exceeds the γ certified for it on
+    its scaled plant: both cannot hold, so one certificate is wrong.  (A D-scale search
+    certified 1.34 on a wrongly reduced scaled plant for a loop whose µ lower bound was
+    50, 2026-11-25; that reduction is now refused, and this check stays as the
+    independent witness.)"""
+    if np.isfinite(gamma) and mu_lower > gamma * (1.0 + _BOUNDS_RTOL):
+        msg = (f"{what}: µ lower bound {mu_lower:.6g} exceeds the certified γ {gamma:.6g} "
+               "on the scaled plant; one of the two certificates is wrong")
+        logger.warning("musyn: %s", msg)
+        return (msg,)
+    return ()
 
 
 @dataclass(frozen=True)
@@ -700,7 +717,9 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
             index=it, gamma=float(syn.gamma), mu_peak=mu_peak,
             mu_lower_peak=lower_peak, peak_omega=peak_omega,
             dfit_orders=orders, controller_order=K.nstates, seconds_k=t1 - t0,
-            seconds_d=t2 - t1, seconds_fit=t4 - t3, warnings=tuple(syn.warnings),
+            seconds_d=t2 - t1, seconds_fit=t4 - t3,
+            warnings=tuple(syn.warnings) + _bound_check(float(syn.gamma), lower_peak,
+                                                        f"iteration {it}"),
             gamma_prev=gamma_prev, K=K, certificates=certs)
         history.append(record)
         K_prev = K_ref
@@ -920,7 +939,8 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
         controller_order=found.K.nstates, seconds_k=t1 - t0,
         seconds_d=time.perf_counter() - t1, seconds_fit=0.0,
         warnings=(f"D-scale search: {found.evaluations} K-steps, gamma "
-                  f"{found.gamma_start:.5g} -> {found.gamma:.5g}",),
+                  f"{found.gamma_start:.5g} -> {found.gamma:.5g}",)
+        + _bound_check(found.gamma, lower_peak, "D-scale search"),
         gamma_prev=found.gamma_start, K=found.K, stage="dscale_search")
 
 
