@@ -6,7 +6,10 @@ is raised by evaluating the largest singular value at the midpoints of the inter
 where ``sigma_max(G(jw)) > gamma_lb (1 + 2 rtol)``; those intervals are read off the
 imaginary-axis eigenvalues of a Hamiltonian matrix.  The iteration converges
 quadratically and stops when the Hamiltonian at the raised level has no eigenvalue on
-the imaginary axis, so the returned value is within ``rtol`` of the true norm.
+the imaginary axis, so the returned value is within ``rtol`` of the true norm.  The
+first lower bound also comes from a logarithmic σ̄ sweep over the poles' band
+(:func:`_sweep`): where the poles span many decades, the Hamiltonian's eigenvalues at
+slow crossings are lost in roundoff, and the sweep is what finds a broad peak there.
 
 Every computation here first balances the realization by a diagonal state similarity
 (LAPACK's ``gebal`` on ``[[A, B], [C, 0]]`` through ``scipy.linalg.matrix_balance``,
