@@ -42,7 +42,7 @@ import scipy.optimize
 
 from ..errors import DimensionError, InputError, ParameterError, SolverError
 from ..lti.checks import as_finite_array, as_statespace
-from ..lti.norms import freqresp
+from ..lti.norms import _sweep, freqresp
 from ..lti.plant import GeneralizedPlant, partition_sizes
 
 __all__ = ["DScaleFit", "fit_magnitude", "fit_dscales", "scaled_plant"]
@@ -670,11 +670,12 @@ _MINREAL_RTOL = 1e-6
 
 def _same_response(reduced: control.StateSpace, full: control.StateSpace) -> bool:
     """Whether ``reduced`` matches ``full`` to ``_MINREAL_RTOL`` at the natural frequencies
-    of ``full``'s poles and on a grid a decade beyond them."""
-    mags = np.abs(np.linalg.eigvals(np.asarray(full.A))) if full.nstates else np.ones(1)
-    mags = mags[mags > 0]
-    lo, hi = (mags.min(), mags.max()) if mags.size else (1.0, 1.0)
-    omega = np.union1d(mags, np.logspace(np.log10(lo) - 1, np.log10(hi) + 1, 60))
+    of ``full``'s poles and on ``hinfnorm``'s sweep of their band."""
+    poles = np.linalg.eigvals(np.asarray(full.A)) if full.nstates else np.zeros(0)
+    mags = np.abs(poles)
+    omega = np.union1d(mags[mags > 0], _sweep(poles))
+    if omega.size == 0:
+        omega = np.ones(1)
     with np.errstate(all="ignore"):
         try:
             H = freqresp(full, omega)

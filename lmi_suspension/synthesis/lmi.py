@@ -483,10 +483,16 @@ _ARE_PSD_RTOL = 1e-5
 
 
 def riccati_frame(P: GeneralizedPlant, gamma: float) -> "Frame | None":
-    """A frame from the stabilising solutions of the two H∞ Riccati equations at an
-    achievable level ``gamma`` (scaled units, ``D22 = 0``), or None where they do not
-    exist or violate the coupling ``ρ(X∞ Y∞) < γ²`` (``gamma`` at or below the
-    optimum, or numerically too close to it).
+    """A frame from the solutions of the two H∞ Riccati equations at an achievable
+    level ``gamma`` (scaled units, ``D22 = 0``), or None where scipy finds none, or
+    they are not positive semidefinite, or they violate the coupling
+    ``ρ(X∞ Y∞) < γ²`` (``gamma`` at or below the optimum, or numerically too close).
+
+    They are not checked to be the stabilising solutions: on D-K plants with a pole at
+    -1e-6 rad/s scipy returned solutions whose closed loop had a pole at +0.0057, and
+    with that check the frame failed over whole ranges of achievable levels (measured
+    2026-11-25).  The frame is only where the γ minimisation starts; the LMI decides
+    the level, and a frame that does not help falls back to the identity frame.
 
     ``X∞`` (full information) and ``Y∞`` (filtering) bound the Lyapunov variables of
     the projected LMIs: ``R = γ X∞⁻¹`` and ``S = γ Y∞⁻¹`` satisfy them at ``γ``, and
