@@ -52,6 +52,22 @@ def test_bench_musyn_distillation(benchmark, method, max_iter, extra):
     assert res.mu_lower_peak <= res.mu_peak
 
 
+@pytest.mark.parametrize("method", ["lmi", "best"])
+def test_bench_musyn_defaults(benchmark, method):
+    """``musyn`` as a user calls it: every option at its default but the K-step method
+    (issue 15's acceptance figure for ``"lmi"``: µ <= 0.98 in <= 30 s)."""
+    ex = skogestad_distillation()
+    res = benchmark.pedantic(
+        musyn, args=(ex.P, ex.nmeas, ex.ncon, ex.blk),
+        kwargs=dict(omega=OMEGA, options=MusynOptions(method=method)), rounds=1,
+        iterations=1)
+    benchmark.extra_info.update(
+        mu_per_iteration=[h.mu_peak for h in res.history], mu_peak_dense=res.mu_peak,
+        mu_lower_peak_dense=res.mu_lower_peak, stop_reason=res.stop_reason,
+        seconds_k_per_iteration=[h.seconds_k for h in res.history])
+    assert res.mu_lower_peak <= res.mu_peak
+
+
 @pytest.mark.parametrize("kstep", ["lmi", "slicot"])
 def test_bench_dkpy_distillation(benchmark, kstep):
     dkpy = pytest.importorskip("dkpy")
