@@ -516,7 +516,8 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
         to 0.994 at iteration 4, where the LMI's own first controller, certified at
         the same level, leads them to 1.04 (measured 2026-11-25; the path is sensitive
         to its start).  A previous design, or one of another method, is a natural
-        start.
+        start.  Without it, ``method="lmi"`` starts from such a central controller by
+        itself (see ``MusynOptions.method``).
 
     Returns
     -------
