@@ -1,4 +1,5 @@
 """Command line: ``lmi-suspension model | reproduce | simulate | sweep | design-constrained |
+refine | tradeoff |
 export``."""
 
 from __future__ import annotations
@@ -191,6 +192,46 @@ def _cmd_design_constrained(args: argparse.Namespace) -> int:
         f"(bound {d.z_bound:g}); fastest pole {d.fastest_pole:.0f} rad/s; "
         f"{d.seconds:.0f} s; written to {out}\n")
     return 0
+
+
+def _cmd_refine(args: argparse.Namespace) -> int:
+    from pathlib import Path
+
+    from .seat.design import design_mu_controller
+    from .seat.refine import (SHIPPED_REFINED, RefineOptions, certify_refined,
+                              refine_seat_controller, save_refined)
+
+    def on_stage(rec):
+        sys.stderr.write(f"stage {rec.index}: {'accepted' if rec.accepted else 'rejected'}, "
+                         f"peak {rec.peak:.3f} m/s², |u| {rec.u_peak:.0f} N, µ {rec.mu:.4f}, "
+                         f"poles {rec.radius:.0f} rad/s ({rec.seconds:.0f} s)\n")
+
+    if args.controller:
+        from .io import load_controller
+
+        K0, _ = load_controller(args.controller)
+    else:
+        K0 = design_mu_controller().K
+    opts = RefineOptions(u_bound=args.u_bound, z_bound=args.z_bound,
+                         disk_radius=args.disk_radius, max_iter=args.max_iter)
+    d = refine_seat_controller(K0, opts, callback=on_stage)
+    out = Path(args.out) if args.out else SHIPPED_REFINED
+    save_refined(out, d)
+    c = certify_refined(d.K)
+    from .seat import bump, bump_limit
+
+    limit = bump_limit(bump()).peak
+    sys.stdout.write(f"{'delay [ms]':>10} {'z3dd peak':>10} {'/limit':>7} {'u cmd [N]':>10} "
+                     f"{'x1 [m]':>8} {'1 kHz peak':>10}\n")
+    for k, dl in enumerate(c.delays):
+        sys.stdout.write(f"{dl * 1e3:10g} {c.peak[k]:10.3f} {c.peak[k] / limit:7.3f} "
+                         f"{c.u_peak[k]:10.0f} {c.x1_peak[k]:8.4f} {c.sampled_peak[k]:10.3f}\n")
+    sys.stdout.write(f"µ upper {c.mu.mu_peak:.4f}, lower {c.mu.mu_lower_peak:.4f}; fastest "
+                     f"pole {c.mu.fastest_pole:.0f} rad/s (controller "
+                     f"{c.mu.controller_fastest_pole:.0f}); delay margin "
+                     f"{c.delay_margin * 1e3:.0f} ms; requirements met: {d.met}; "
+                     f"{d.seconds:.0f} s; written to {out}\n")
+    return 0 if d.met else 1
 
 
 def _cmd_tradeoff(args: argparse.Namespace) -> int:
@@ -461,6 +502,22 @@ def build_parser() -> argparse.ArgumentParser:
     p_dc.add_argument("--out", default=None,
                       help="controller file to write (default: the one shipped in the package)")
     p_dc.set_defaults(func=_cmd_design_constrained)
+
+    p_rf = sub.add_parser("refine",
+                          help="refine the µ controller to exact bump requirements (force, "
+                               "stroke, µ, poles) by a fixed-order search (minutes); writes "
+                               "the controller file reproduce loads")
+    p_rf.add_argument("--controller", default=None,
+                      help="start controller JSON (default: the µ design, designed now)")
+    p_rf.add_argument("--u-bound", type=float, default=1500.0,
+                      help="commanded |u| on the bump at every delay 0-25 ms, N")
+    p_rf.add_argument("--z-bound", type=float, default=0.08, help="|x1| on the bump, m")
+    p_rf.add_argument("--disk-radius", type=float, default=1900.0,
+                      help="controller and loop poles in |s| < this, rad/s")
+    p_rf.add_argument("--max-iter", type=int, default=600, help="SLSQP iterations in all")
+    p_rf.add_argument("--out", default=None,
+                      help="controller file to write (default: the one shipped in the package)")
+    p_rf.set_defaults(func=_cmd_refine)
 
     p_to = sub.add_parser("tradeoff",
                           help="the force bound's price: one design-constrained per bound "

@@ -35,10 +35,12 @@ EXPECTED_PNGS = {
     "fig07_bump.png", "fig08_white_noise.png", "fig09_bump_z3dd.png", "fig10_bump_x1.png",
     "fig11_bump_u_applied.png", "fig12_noise_z3dd.png", "fig13_noise_x1.png",
     "fig14_noise_u_applied.png", "fig15_mu_bounds.png", "peak_vs_delay.png", "iso_C_z3dd.png",
-    "force_commanded_vs_applied.png", "mu_bounds_constrained.png",
+    "force_commanded_vs_applied.png", "mu_bounds_constrained.png", "mu_bounds_refined.png",
 }
 #: the stand-in of the shipped constrained controller: a weaker low-passed stiffness
 K_CONSTRAINED = control.ss([[-150.0]], [[150.0, 0.0]], [[4000.0]], [[0.0, 500.0]])
+#: the stand-in of the shipped refined controller: another low-passed stiffness
+K_REFINED = control.ss([[-250.0]], [[250.0, 0.0]], [[6000.0]], [[0.0, 800.0]])
 
 
 def _stand_in(fail_riccati=False):
@@ -79,8 +81,12 @@ def _stand_in(fail_riccati=False):
         Kd = discretise_controller(K_CONSTRAINED, 1e-3)
         return K_CONSTRAINED, Kd, {"description": "stand-in", "u_bound": 4000.0}
 
-    def certify_constrained(K, rng=None):
-        calls.append("certify")
+    def load_refined():
+        Kd = discretise_controller(K_REFINED, 1e-3)
+        return K_REFINED, Kd, {"description": "stand-in refined", "u_bound": 1500.0}
+
+    def certify_constrained(K, design=None, rng=None):
+        calls.append("certify" if design is None else "certify refined")
         return ConstrainedCheck(mu_peak=1.2, mu_lower_peak=1.1, omega=omega,
                                 mu_upper=1.2 * upper / upper.max(),
                                 mu_lower=1.1 * upper / upper.max(), u_peak=3000.0,
@@ -91,6 +97,7 @@ def _stand_in(fail_riccati=False):
                           design_nominal_hinf=design_nominal_hinf,
                           analyse_uncertainty=analyse_uncertainty,
                           load_constrained=load_constrained,
+                          load_refined=load_refined,
                           certify_constrained=certify_constrained,
                           DEFAULT_DESIGN=SeatDesignOptions(), DEFAULT_MUSYN=None)
     return api, K_mu, history, calls
@@ -187,7 +194,7 @@ def test_controller_json_round_trips_exactly(run):
 def test_every_controller_file_holds_both_realizations(run):
     from lmi_suspension.io import load_discrete_controller
 
-    for name in ("mu", "mu_constrained"):
+    for name in ("mu", "mu_constrained", "mu_refined"):
         K, _ = load_controller(run.out / "controllers" / f"{name}.json")
         Kd, meta = load_discrete_controller(run.out / "controllers" / f"{name}.json")
         assert Kd.dt == 1e-3 and meta["fastest_pole"] > 0
@@ -196,6 +203,9 @@ def test_every_controller_file_holds_both_realizations(run):
         assert np.allclose(np.asarray(Kd(np.exp(0.02j))), np.asarray(ref(np.exp(0.02j))))
     K, _ = load_controller(run.out / "controllers" / "mu_constrained.json")
     assert np.array_equal(np.asarray(K.A), np.asarray(K_CONSTRAINED.A))
+    K, meta = load_controller(run.out / "controllers" / "mu_refined.json")
+    assert np.array_equal(np.asarray(K.D), np.asarray(K_REFINED.D))
+    assert meta["description"] == "stand-in refined"
 
 
 @pytest.mark.slow
@@ -209,6 +219,16 @@ def test_constrained_row_reports_commanded_force_and_the_sampled_loop(run):
     data = json.loads((run.out / "summary.json").read_text())
     assert data["mu_constrained"]["check"]["mu_peak"] == 1.2
     assert "certify" in run.calls
+
+
+@pytest.mark.slow
+def test_refined_row_is_simulated_and_certified_with_the_paper_weights(run):
+    c = run.summary.controller("mu_refined")
+    road = bump(t_end=R._QUICK.bump_t_end, dt=R._QUICK.road_dt)
+    direct = simulate(K_REFINED, road, delay=0.025, dt=R._QUICK.sim_dt)
+    assert c.peak_z3dd[-1] == pytest.approx(np.max(np.abs(direct.z3dd)), rel=1e-12)
+    assert len(c.sampled_peak_z3dd) == len(c.delays)
+    assert "certify refined" in run.calls
 
 
 @pytest.mark.slow

@@ -37,16 +37,18 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 #: Names of the compared controllers, in table order.
-CONTROLLER_NAMES = ("passive", "hinf_lmi_nominal", "hinf_riccati", "mu", "mu_constrained")
+CONTROLLER_NAMES = ("passive", "hinf_lmi_nominal", "hinf_riccati", "mu", "mu_constrained",
+                    "mu_refined")
 #: the stages of :func:`reproduce`, in order: each announces itself with one progress
 #: message that does not start with a space (details follow indented), and its wall time
 #: is ``summary.json``'s ``timings[name]``
-STAGES = ("mu_design", "mu_analysis", "mu_constrained", "hinf_lmi_nominal", "hinf_riccati",
+STAGES = ("mu_design", "mu_analysis", "mu_constrained", "mu_refined", "hinf_lmi_nominal",
+          "hinf_riccati",
           "limit",
           *(f"simulate_{n}" for n in CONTROLLER_NAMES), "iso_C", "monte_carlo", "figures")
 _LONG_NAMES = {"passive": "passive", "hinf_lmi_nominal": "H∞ LMI (no delay)",
                "hinf_riccati": "H∞ Riccati", "mu": "µ (D-K)",
-               "mu_constrained": "µ, hard bounds"}
+               "mu_constrained": "µ, hard bounds", "mu_refined": "µ, refined to the bounds"}
 #: sample time of every controller's discrete realization in controllers/<name>.json
 _SAMPLE_TIME = 1e-3
 
@@ -214,8 +216,9 @@ def _design_api():
     """The seat designs (imported late: they are heavy, and tests replace them)."""
     from types import SimpleNamespace
 
-    from ..seat import constrained, design
+    from ..seat import constrained, design, refine
     return SimpleNamespace(
+        load_refined=refine.load_refined,
         design_mu_controller=design.design_mu_controller,
         analyse_uncertainty=design.analyse_uncertainty,
         design_nominal_hinf=design.design_nominal_hinf,
@@ -418,6 +421,24 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         say(f"  mu_constrained failed: {errors['mu_constrained']}")
     done(tok)
 
+    # --- the µ controller refined to the exact bump requirements (shipped) ------------
+    tok = stage("mu_refined", "µ controller refined to the force/stroke/pole bounds "
+                "(shipped, re-certified) ...")
+    refined = None
+    try:
+        K_r, Kd_r, meta_r = api.load_refined()
+        check_r = api.certify_constrained(K_r, design=api.DEFAULT_DESIGN,
+                                          rng=np.random.default_rng(
+                                              int(rng_analysis.integers(2**63))))
+        refined = (K_r, Kd_r, meta_r, check_r)
+        say(f"  µ upper {check_r.mu_peak:.4f}, lower {check_r.mu_lower_peak:.4f}; fastest "
+            f"pole {check_r.fastest_pole:.0f} rad/s (controller "
+            f"{check_r.controller_fastest_pole:.0f})")
+    except (LmiSuspensionError, OSError) as exc:
+        errors["mu_refined"] = f"{type(exc).__name__}: {exc}"
+        say(f"  mu_refined failed: {errors['mu_refined']}")
+    done(tok)
+
     # --- comparison controllers ------------------------------------------------------
     controllers: dict[str, object] = {"passive": None}
     for name, method in (("hinf_lmi_nominal", "lmi"), ("hinf_riccati", "riccati")):
@@ -432,6 +453,8 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     discrete = {}
     if constrained is not None:
         controllers["mu_constrained"], discrete["mu_constrained"] = constrained[:2]
+    if refined is not None:
+        controllers["mu_refined"], discrete["mu_refined"] = refined[:2]
 
     # --- roads and the physical limit ------------------------------------------------
     road_bump = bump(t_end=cfg.bump_t_end, dt=cfg.road_dt)
@@ -554,8 +577,9 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         if K is None:
             continue
         Kd = discrete.get(name) or discretise_controller(K, _SAMPLE_TIME)
+        shipped = {"mu_constrained": constrained, "mu_refined": refined}.get(name)
         meta = dict(metadata) if name == "mu" else (
-            dict(constrained[2]) if name == "mu_constrained" else
+            dict(shipped[2]) if shipped is not None else
             {"description": f"{_LONG_NAMES[name]}: y = [x1, x3] (m) -> u (N)"})
         meta["fastest_pole"] = float(np.max(np.abs(np.linalg.eigvals(np.asarray(K.A))))) \
             if K.nstates else 0.0
@@ -618,7 +642,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
          "peak_vs_delay.png")
     save(figures.plot_responses(iso_runs, "z3dd", title=road_iso.description), "iso_C_z3dd.png")
     forced = {f"{_LONG_NAMES[n]}, d = {d * 1e3:g} ms": runs["bump"][n][d]
-              for n in ("mu", "mu_constrained") if n in controllers
+              for n in ("mu", "mu_constrained", "mu_refined") if n in controllers
               for d in (delays[0], delays[-1])}
     save(figures.plot_commanded_force(forced, limit=u_max, t_max=1.5,
                                       title="Bump: commanded (solid) and applied (dashed) "
@@ -629,6 +653,11 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         save(figures.plot_mu_bounds(check_c.omega, check_c.mu_upper, check_c.mu_lower,
                                     title="µ bounds, µ design with hard force/stroke bounds"),
              "mu_bounds_constrained.png")
+    if refined is not None:
+        check_r = refined[3]
+        save(figures.plot_mu_bounds(check_r.omega, check_r.mu_upper, check_r.mu_lower,
+                                    title="µ bounds, µ controller refined to the bounds"),
+             "mu_bounds_refined.png")
     done(tok)
 
     # --- summary.json ---------------------------------------------------------------
@@ -660,6 +689,8 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         "musyn_options": metadata["musyn_options"],
         "mu_constrained": None if constrained is None else {
             "check": constrained[3], "design": constrained[2]},
+        "mu_refined": None if refined is None else {
+            "check": refined[3], "design": refined[2]},
         "timings": timings,
     }
     data = _jsonable(data)
