@@ -1,4 +1,5 @@
-"""The ``lmi-suspension`` command line: ``model``, ``simulate`` and its error exits."""
+"""The ``lmi-suspension`` command line: ``model``, ``simulate``, ``refine`` and its error
+exits."""
 
 import json
 import subprocess
@@ -135,3 +136,22 @@ def test_simulate_discrete_runs_the_sampled_data_loop(capsys, tmp_path):
     assert data["peak_z3dd"] == pytest.approx(np.max(np.abs(direct.z3dd)), rel=1e-12)
     assert data["peak_u_command"] == pytest.approx(np.max(np.abs(direct.u_command)),
                                                    rel=1e-12)
+
+
+def test_refine_writes_a_controller_and_its_certificate(capsys, tmp_path):
+    """``refine`` with one SLSQP iteration: far from the requirements (exit status 1),
+    but the file is written with both realizations and the certificate's table printed;
+    its figures are the time simulation's, recomputed here."""
+    from lmi_suspension.io import load_controller, load_discrete_controller
+
+    out = tmp_path / "r.json"
+    assert main(["refine", "--max-iter", "1", "--out", str(out)]) == 1
+    K, meta = load_controller(out)
+    Kd, _ = load_discrete_controller(out)
+    assert Kd.dt == 1e-3 and meta["met"] is False
+    text = capsys.readouterr().out
+    row = text.splitlines()[1].split()          # delay 0
+    m = simulate(K, bump(), delay=0.0, u_max=np.inf).metrics()
+    assert float(row[1]) == pytest.approx(m.peak_z3dd, abs=1e-3)
+    assert float(row[3]) == pytest.approx(m.peak_u_command, abs=0.5)
+    assert "µ upper" in text
