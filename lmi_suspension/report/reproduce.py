@@ -48,7 +48,7 @@ STAGES = ("mu_design", "mu_analysis", "mu_constrained", "mu_refined", "hinf_lmi_
           *(f"simulate_{n}" for n in CONTROLLER_NAMES), "iso_C", "monte_carlo", "figures")
 _LONG_NAMES = {"passive": "passive", "hinf_lmi_nominal": "H∞ LMI (no delay)",
                "hinf_riccati": "H∞ Riccati", "mu": "µ (D-K)",
-               "mu_constrained": "µ, hard bounds", "mu_refined": "µ, refined to the bounds"}
+               "mu_constrained": "µ, hard bounds", "mu_refined": "µ, refined"}
 #: sample time of every controller's discrete realization in controllers/<name>.json
 _SAMPLE_TIME = 1e-3
 
