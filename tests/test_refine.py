@@ -200,3 +200,20 @@ def test_shipped_sampled_loop_reproduces_the_continuous_peak(shipped):
 
 def test_shipped_delay_margin_covers_the_delay_range(shipped):
     assert shipped[3].delay_margin > 0.025
+
+
+def test_save_refined_round_trips_exactly(shipped, tmp_path):
+    """A saved design reads back bit for bit, with the Tustin realization beside it."""
+    from lmi_suspension.seat.refine import RefinedDesign, save_refined
+
+    K = shipped[0]
+    z = np.zeros(len(REFINE_DELAYS))
+    d = RefinedDesign(K=K, K0=K, peak=z, u_peak=z, x1_peak=z, mu=0.9, radius=1.0, met=True,
+                      options=RefineOptions(), stages=(), iterations=0, seconds=0.0)
+    K2, Kd2, meta = load_refined(save_refined(tmp_path / "k.json", d))
+    for name in "ABCD":
+        assert np.array_equal(np.asarray(getattr(K2, name)), np.asarray(getattr(K, name)))
+    ref = control.sample_system(K, 1e-3, method="bilinear")
+    assert np.allclose(np.asarray(Kd2(np.exp(0.05j))), np.asarray(ref(np.exp(0.05j))),
+                       rtol=1e-8)
+    assert meta["u_bound"] == 1500.0 and meta["met"] is True
