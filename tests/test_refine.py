@@ -217,3 +217,21 @@ def test_save_refined_round_trips_exactly(shipped, tmp_path):
     assert np.allclose(np.asarray(Kd2(np.exp(0.05j))), np.asarray(ref(np.exp(0.05j))),
                        rtol=1e-8)
     assert meta["u_bound"] == 1500.0 and meta["met"] is True
+
+
+def test_shipped_tradeoff_holds_the_shipped_design(shipped):
+    """The trade-off file's 1500 N point is the shipped controller's certificate, and
+    a larger force bound buys a lower peak (the measurement's shape)."""
+    from lmi_suspension.report.figures import plot_constrained_tradeoff
+    from lmi_suspension.seat.refine import load_refined_tradeoff
+
+    points, table = load_refined_tradeoff()
+    at = {p.u_bound: p for p in points}
+    check = shipped[3]
+    assert at[1500.0].bump_peak == pytest.approx(check.peak, rel=1e-6)
+    assert at[1500.0].mu_peak == pytest.approx(check.mu.mu_peak, rel=1e-6)
+    met = [p for p, row in zip(points, table["points"]) if row["met"]]
+    worst = [max(p.bump_peak) for p in sorted(met, key=lambda p: p.u_bound)]
+    assert worst == sorted(worst, reverse=True)
+    fig = plot_constrained_tradeoff(points, limit=table["limit"], label="refined designs")
+    assert len(fig.axes) == 2

@@ -252,7 +252,8 @@ def plot_force_tradeoff(u_bounds: Sequence[float], hinf: Sequence[float],
 def plot_constrained_tradeoff(points: Sequence, *, limit: float,
                               reference: Mapping[str, tuple] | None = None,
                               u_actuator: float = 1500.0, goal: float = 1.3,
-                              title: str = "") -> Figure:
+                              title: str = "",
+                              label: str = "constrained µ designs") -> Figure:
     """The trade-off of the constrained µ designs (issue 17): bump peak against commanded
     force, and µ against the force bound.
 
@@ -270,6 +271,8 @@ def plot_constrained_tradeoff(points: Sequence, *, limit: float,
         The actuator's force limit, N.
     goal : float
         The goal as a multiple of ``limit``.
+    label : str
+        What the points are (the legend's first entry).
 
     Examples
     --------
@@ -287,7 +290,7 @@ def plot_constrained_tradeoff(points: Sequence, *, limit: float,
     u_cmd = np.array([max(p.bump_u) for p in pts])
     worst = np.array([max(p.bump_peak) for p in pts])
     best = np.array([min(p.bump_peak) for p in pts])
-    a1.plot(u_cmd, worst, "o-", color="C0", label="constrained µ designs, worst delay")
+    a1.plot(u_cmd, worst, "o-", color="C0", label=f"{label}, worst delay")
     a1.plot(u_cmd, best, "o--", mfc="none", color="C0", label="best delay")
     for p, x, y in zip(pts, u_cmd, worst):
         a1.annotate(f"{p.u_bound:g} N", (x, y), textcoords="offset points", xytext=(4, 4),

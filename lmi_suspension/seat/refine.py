@@ -45,7 +45,8 @@ from .roads import RoadInput, bump
 
 __all__ = ["BumpResponse", "TwoBlockMu", "RefineOptions", "RefineStage", "RefinedDesign",
            "RefinedCheck", "REFINE_DELAYS", "SHIPPED_REFINED", "certify_refined",
-           "frequency_response", "load_refined", "loop_poles", "modal_form",
+           "SHIPPED_REFINED_TRADEOFF", "frequency_response", "load_refined",
+           "load_refined_tradeoff", "loop_poles", "modal_form",
            "refine_seat_controller", "save_refined"]
 
 logger = logging.getLogger(__name__)
@@ -822,6 +823,9 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
 #: the refined design shipped with the package (``lmi-suspension refine`` writes it;
 #: ``reproduce`` loads and re-certifies it)
 SHIPPED_REFINED = Path(__file__).parent / "data" / "mu_refined.json"
+#: the force bound's price on this route, measured by ``lmi-suspension refine --u-bound``
+#: (the command and date are inside), read by :func:`load_refined_tradeoff`
+SHIPPED_REFINED_TRADEOFF = Path(__file__).parent / "data" / "tradeoff_refined.json"
 
 
 @dataclass(frozen=True)
@@ -936,3 +940,28 @@ def load_refined(path=None) -> tuple:
     K, meta = load_controller(path)
     Kd, _ = load_discrete_controller(path)
     return K, Kd, meta
+
+
+def load_refined_tradeoff(path=None) -> tuple[tuple, dict]:
+    """The trade-off over the force bound of refined designs: ``(points, table)``, the
+    points as :class:`~.constrained.TradeoffPoint` (``u_bound``, µ, bump figures per
+    delay), ``table["points"][k]["met"]`` whether the search met every requirement.
+    Plot with :func:`~lmi_suspension.report.figures.plot_constrained_tradeoff`.
+
+    Examples
+    --------
+    >>> points, table = load_refined_tradeoff()
+    >>> [p.u_bound for p in points]
+    [1250.0, 1500.0, 2000.0, 3000.0]
+    """
+    import json
+
+    from .constrained import TradeoffPoint
+
+    table = json.loads(Path(SHIPPED_REFINED_TRADEOFF if path is None else path).read_text())
+    keys = {"u_bound", "mu_peak", "mu_lower_peak", "u_peak", "delays", "bump_peak", "bump_u",
+            "bump_x1", "seconds"}
+    points = tuple(TradeoffPoint(**{k: tuple(v) if isinstance(v, list) else v
+                                    for k, v in p.items() if k in keys})
+                   for p in table["points"])
+    return points, table
