@@ -233,5 +233,6 @@ def test_shipped_tradeoff_holds_the_shipped_design(shipped):
     met = [p for p, row in zip(points, table["points"]) if row["met"]]
     worst = [max(p.bump_peak) for p in sorted(met, key=lambda p: p.u_bound)]
     assert worst == sorted(worst, reverse=True)
-    fig = plot_constrained_tradeoff(points, limit=table["limit"], label="refined designs")
+    fig = plot_constrained_tradeoff(points, limit=table["limit"], label="refined designs",
+                                    bound_label="commanded force bound on the bump")
     assert len(fig.axes) == 2

@@ -253,7 +253,9 @@ def plot_constrained_tradeoff(points: Sequence, *, limit: float,
                               reference: Mapping[str, tuple] | None = None,
                               u_actuator: float = 1500.0, goal: float = 1.3,
                               title: str = "",
-                              label: str = "constrained µ designs") -> Figure:
+                              label: str = "constrained µ designs",
+                              bound_label: str = "force bound in the K-step (bump's energy)"
+                              ) -> Figure:
     """The trade-off of the constrained µ designs (issue 17): bump peak against commanded
     force, and µ against the force bound.
 
@@ -273,6 +275,8 @@ def plot_constrained_tradeoff(points: Sequence, *, limit: float,
         The goal as a multiple of ``limit``.
     label : str
         What the points are (the legend's first entry).
+    bound_label : str
+        What ``u_bound`` bounds (the second axes' abscissa).
 
     Examples
     --------
@@ -308,7 +312,7 @@ def plot_constrained_tradeoff(points: Sequence, *, limit: float,
     a2.plot([p.u_bound for p in pts], [p.mu_peak for p in pts], "o-", color="C1",
             label="µ upper bound (delay cover 0–25 ms)")
     a2.axhline(1.0, color="k", lw=1, label="µ = 1")
-    a2.set_xlabel("force bound in the K-step (bump's energy) [N]")
+    a2.set_xlabel(f"{bound_label} [N]")
     a2.set_ylabel("µ")
     a2.set_ylim(bottom=0)
     a2.legend(fontsize=8)
