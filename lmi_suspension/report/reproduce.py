@@ -402,42 +402,34 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
             f"{check.mu_lower_peak:.4f}")
     done(tok)
 
-    # --- the µ design with hard bounds (shipped: its D-K takes minutes) ---------------
-    tok = stage("mu_constrained", "µ design with hard force/stroke bounds (shipped, "
-                "re-certified) ...")
-    constrained = None
+    # --- the shipped designs (their searches take minutes): loaded and re-certified ----
     errors: dict[str, str] = {}
-    try:
-        K_c, Kd_c, meta_c = api.load_constrained()
-        check_c = api.certify_constrained(K_c, rng=np.random.default_rng(
-            int(rng_analysis.integers(2**63))))
-        constrained = (K_c, Kd_c, meta_c, check_c)
-        say(f"  µ upper {check_c.mu_peak:.4f}, lower {check_c.mu_lower_peak:.4f}; worst case "
-            f"over floor velocities of the bump's energy: |u| {check_c.u_peak:.0f} N, |x1| "
-            f"{check_c.x1_peak:.4f} m; fastest pole {check_c.fastest_pole:.0f} rad/s "
-            f"(controller {check_c.controller_fastest_pole:.0f})")
-    except (LmiSuspensionError, OSError) as exc:
-        errors["mu_constrained"] = f"{type(exc).__name__}: {exc}"
-        say(f"  mu_constrained failed: {errors['mu_constrained']}")
-    done(tok)
 
-    # --- the µ controller refined to the exact bump requirements (shipped) ------------
-    tok = stage("mu_refined", "µ controller refined to the force/stroke/pole bounds "
-                "(shipped, re-certified) ...")
-    refined = None
-    try:
-        K_r, Kd_r, meta_r = api.load_refined()
-        check_r = api.certify_constrained(K_r, design=api.DEFAULT_DESIGN,
-                                          rng=np.random.default_rng(
-                                              int(rng_analysis.integers(2**63))))
-        refined = (K_r, Kd_r, meta_r, check_r)
-        say(f"  µ upper {check_r.mu_peak:.4f}, lower {check_r.mu_lower_peak:.4f}; fastest "
-            f"pole {check_r.fastest_pole:.0f} rad/s (controller "
-            f"{check_r.controller_fastest_pole:.0f})")
-    except (LmiSuspensionError, OSError) as exc:
-        errors["mu_refined"] = f"{type(exc).__name__}: {exc}"
-        say(f"  mu_refined failed: {errors['mu_refined']}")
-    done(tok)
+    def shipped(name, message, load, describe, **certify):
+        tok = stage(name, message)
+        result = None
+        try:
+            K_s, Kd_s, meta_s = load()
+            check = api.certify_constrained(K_s, rng=np.random.default_rng(
+                int(rng_analysis.integers(2**63))), **certify)
+            result = (K_s, Kd_s, meta_s, check)
+            say(f"  µ upper {check.mu_peak:.4f}, lower {check.mu_lower_peak:.4f}; "
+                + describe(check) + f"fastest pole {check.fastest_pole:.0f} rad/s "
+                f"(controller {check.controller_fastest_pole:.0f})")
+        except (LmiSuspensionError, OSError) as exc:
+            errors[name] = f"{type(exc).__name__}: {exc}"
+            say(f"  {name} failed: {errors[name]}")
+        done(tok)
+        return result
+
+    constrained = shipped(
+        "mu_constrained", "µ design with hard force/stroke bounds (shipped, re-certified) ...",
+        api.load_constrained,
+        lambda c: (f"worst case over floor velocities of the bump's energy: |u| "
+                   f"{c.u_peak:.0f} N, |x1| {c.x1_peak:.4f} m; "))
+    refined = shipped(
+        "mu_refined", "µ controller refined to the force/stroke/pole bounds (shipped, "
+        "re-certified) ...", api.load_refined, lambda c: "", design=api.DEFAULT_DESIGN)
 
     # --- comparison controllers ------------------------------------------------------
     controllers: dict[str, object] = {"passive": None}

@@ -126,13 +126,8 @@ class BumpResponse:
         cache = dict(n=n, dt=dt, s=s, W=np.fft.rfft(w), keep=road.w.size,
                      Gy_w=fr(M.C3, M.Bw), Gy_u=fr(M.C3, M.B), Gz_w=fr(M.C1, M.Bw)[0, 0],
                      Gz_u=fr(M.C1, M.B)[0, 0], Gx_w=fr(M.C2, M.Bw)[0, 0],
-                     Gx_u=fr(M.C2, M.B)[0, 0], E=np.exp(-np.outer(delays, s)), nx=M.A.shape[0])
+                     Gx_u=fr(M.C2, M.B)[0, 0], E=np.exp(-np.outer(delays, s)))
         object.__setattr__(self, "_c", cache)
-
-    @property
-    def nstates(self) -> int:
-        """Order of the seat model."""
-        return int(self._c["nx"])
 
     def peaks(self, K) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(peak |z̈3|, peak |u| commanded, peak |x1|)``, one entry per delay, over
@@ -220,11 +215,6 @@ class TwoBlockMu:
         nz, nw, ny, nu = c["nz"], c["nw"], c["ny"], c["nu"]
         return (Pw[:nz, :nw], Pw[:nz, nw:nw + nu][:, 0], Pw[nz:nz + ny, :nw],
                 Pw[nz:nz + ny, nw:nw + nu][:, 0])
-
-    @property
-    def size(self) -> int:
-        """Number of grid frequencies."""
-        return int(self._c["omega"].size)
 
     def loop_poles(self, K) -> np.ndarray:
         """Poles of the µ loop ``F_l(P, K)`` (the weights' poles included)."""
@@ -577,6 +567,7 @@ class _Problem:
         self.ny = np.asarray(K0.B).shape[1]
         self._cache: dict = {}
         self.best: _Point | None = None
+        self.size = 0       # of the constraint vector, set from the start point
         self.best_y: np.ndarray | None = None
 
     def controller(self, y: np.ndarray) -> control.StateSpace:
