@@ -36,6 +36,7 @@ EXPECTED_PNGS = {
     "fig11_bump_u_applied.png", "fig12_noise_z3dd.png", "fig13_noise_x1.png",
     "fig14_noise_u_applied.png", "fig15_mu_bounds.png", "peak_vs_delay.png", "iso_C_z3dd.png",
     "force_commanded_vs_applied.png", "mu_bounds_constrained.png", "mu_bounds_refined.png",
+    "tradeoff_refined.png",
 }
 #: the stand-in of the shipped constrained controller: a weaker low-passed stiffness
 K_CONSTRAINED = control.ss([[-150.0]], [[150.0, 0.0]], [[4000.0]], [[0.0, 500.0]])
@@ -85,6 +86,13 @@ def _stand_in(fail_riccati=False):
         Kd = discretise_controller(K_REFINED, 1e-3)
         return K_REFINED, Kd, {"description": "stand-in refined", "u_bound": 1500.0}
 
+    def load_refined_tradeoff():
+        calls.append("tradeoff")
+        points = tuple(SimpleNamespace(u_bound=b, mu_peak=0.98, bump_peak=(p, p + 0.3),
+                                       bump_u=(0.99 * b, b))
+                       for b, p in ((1500.0, 8.8), (2000.0, 6.3)))
+        return points, {"points": []}
+
     def certify_constrained(K, design=None, rng=None):
         calls.append("certify" if design is None else "certify refined")
         return ConstrainedCheck(mu_peak=1.2, mu_lower_peak=1.1, omega=omega,
@@ -98,6 +106,7 @@ def _stand_in(fail_riccati=False):
                           analyse_uncertainty=analyse_uncertainty,
                           load_constrained=load_constrained,
                           load_refined=load_refined,
+                          load_refined_tradeoff=load_refined_tradeoff,
                           certify_constrained=certify_constrained,
                           DEFAULT_DESIGN=SeatDesignOptions(), DEFAULT_MUSYN=None)
     return api, K_mu, history, calls

@@ -306,9 +306,12 @@ def plot_constrained_tradeoff(points: Sequence, *, limit: float,
     a1.axvline(u_actuator, color="C3", ls=":", label=f"actuator {u_actuator:g} N")
     a1.set_xlabel("largest commanded $|u|$ on the bump, 0–25 ms [N]")
     a1.set_ylabel("peak $|\\ddot z_3|$ on the bump [m/s²]")
-    a1.set_ylim(bottom=0)
+    # room above the highest point for its label; the legend where no design lies
+    # (below the limit at small forces: no design reaches the limit without force)
+    tops = [*worst, goal * limit] + [max(peak) for _u, peak in (reference or {}).values()]
+    a1.set_ylim(0, 1.12 * max(tops))
     a1.set_xlim(left=0)
-    a1.legend(fontsize=8, loc="upper right")
+    a1.legend(fontsize=8, loc="lower left")
     a2.plot([p.u_bound for p in pts], [p.mu_peak for p in pts], "o-", color="C1",
             label="µ upper bound (delay cover 0–25 ms)")
     a2.axhline(1.0, color="k", lw=1, label="µ = 1")

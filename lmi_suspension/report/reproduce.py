@@ -219,6 +219,7 @@ def _design_api():
     from ..seat import constrained, design, refine
     return SimpleNamespace(
         load_refined=refine.load_refined,
+        load_refined_tradeoff=refine.load_refined_tradeoff,
         design_mu_controller=design.design_mu_controller,
         analyse_uncertainty=design.analyse_uncertainty,
         design_nominal_hinf=design.design_nominal_hinf,
@@ -301,7 +302,10 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     ``controller.json`` (the µ controller, ``y = [x1, x3]`` in m to ``u`` in N);
     ``controllers/<name>.json`` for every designed controller, each with its 1 kHz
     discrete realization (``Ad``, ``Bd``, ``Cd``, ``Dd``, ``dt``);
-    ``force_commanded_vs_applied.png`` and ``mu_bounds_constrained.png``.
+    ``force_commanded_vs_applied.png``, ``mu_bounds_constrained.png``,
+    ``mu_bounds_refined.png`` and ``tradeoff_refined.png`` (the shipped trade-off of the
+    refinement over the force bound, :func:`~lmi_suspension.seat.refine.load_refined_tradeoff`,
+    with this run's µ and refined controllers).
 
     The µ design with hard force and stroke bounds (``mu_constrained``,
     :func:`~lmi_suspension.seat.constrained.design_constrained_mu`) takes minutes, so the
@@ -650,6 +654,19 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         save(figures.plot_mu_bounds(check_r.omega, check_r.mu_upper, check_r.mu_lower,
                                     title="µ bounds, µ controller refined to the bounds"),
              "mu_bounds_refined.png")
+        # the price of the force bound (shipped: a refinement per bound takes 5-25 min),
+        # against this run's µ and refined controllers on the same bump
+        points, _table = api.load_refined_tradeoff()
+        reference = {}
+        for name in ("mu", "mu_refined"):
+            m = [runs["bump"][name][d].metrics() for d in delays]
+            reference[f"{_LONG_NAMES[name]} (this run)"] = (
+                tuple(r.peak_u_command for r in m), tuple(r.peak_z3dd for r in m))
+        save(figures.plot_constrained_tradeoff(
+            points, limit=limit.peak, u_actuator=u_max, reference=reference,
+            label="refined designs (shipped)", bound_label="force bound of the refinement",
+            title="Bump peak against the force bound (refined µ designs)"),
+            "tradeoff_refined.png")
     done(tok)
 
     # --- summary.json ---------------------------------------------------------------

@@ -2,6 +2,9 @@
 
 model (Table 1, eq. 1) -> uncertainty and weights -> augmented plant of Fig. 2;
 roads -> exact-delay simulation -> comfort metrics; the physical limit of the bump.
+The designs: :mod:`.design` (µ-synthesis as in the paper), :mod:`.constrained` (hard
+force and stroke bounds in the K-step), :mod:`.refine` (the µ controller refined to the
+exact bump requirements) and :mod:`.sampled` (the 1 kHz implementation).
 """
 
 from .augmented import BUMP_PEAK_VELOCITY, SeatAugmentedPlant, SeatDesignOptions, seat_augmented_plant
@@ -16,6 +19,9 @@ from .simulate import (MonteCarloResult, SimulationMetrics, SimulationResult, cl
                        loop_transfer, monte_carlo, simulate, simulate_force, stability_delay_margin)
 from .limit import LimitResult, bump_limit
 from .bounded import PeakBoundedDesign, design_peak_bounded, road_energy
+# the designs' own modules, documented as modules: the µ design, its constrained K-step
+# route, the refinement, and the sampled-data implementation
+from . import constrained, design, refine, sampled
 
 __all__ = [
     "SeatParameters", "SeatMatrices", "seat_matrices", "seat_model", "natural_modes",
@@ -29,4 +35,5 @@ __all__ = [
     "closed_loop_stable", "loop_transfer", "stability_delay_margin", "monte_carlo",
     "LimitResult", "bump_limit",
     "PeakBoundedDesign", "design_peak_bounded", "road_energy",
+    "design", "constrained", "refine", "sampled",
 ]
