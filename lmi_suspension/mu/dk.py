@@ -60,6 +60,14 @@ _OFFGRID_RTOL = 0.05
 #: 0.9786 / 0.9774 / 0.9748 in 77 / 33 / 63 / 65 s: any of them beats the LMI's own
 #: start, and 1 % was the fastest
 _CENTRAL_START_RELAX = 0.01
+#: the level of the LMI K-step above the γ certified for SLICOT's controller
+#: (:func:`_level_led_lmi`)
+_LEVEL_RELAX = 3e-3
+#: Clarabel recoveries and reconstruction levels of that K-step: the controller LMI
+#: succeeded at its second attempt on 5 of 7 plants of a distillation run, and on the
+#: other two further recoveries cost 9 s each and ended "infeasible" all the same
+#: (measured 2026-11-26)
+_LEVEL_LED_RECOVERIES = 1
 #: slack of the check µ lower bound <= certified γ of an iterate (the µ bounds are
 #: computed to about 1e-4 on the grid, and γ to 1e-9 by hinfnorm)
 _BOUNDS_RTOL = 1e-3
@@ -102,11 +110,15 @@ class MusynOptions:
         route (abandoned when its γ minimisation stops above
         twice a certified Riccati γ, and skipped on scaled plants of more than 30 states
         once Riccati has a controller), and keeps the controller with the lowest
-        certified closed-loop γ.  From the second iteration on, the LMI K-step knows
-        the previous controller's level on the new scaled plant: its γ minimisation
-        starts in the frame of the Riccati solutions at that level and gives up where
-        it stops above it (``gamma_abort``, unless the options set one); where it fails
-        on an over-relaxed plant, the plain D-step's plant is used instead.  With
+        certified closed-loop γ.  From the second iteration on, the LMI K-step is
+        posed at a level fixed in advance, 0.3 % above the norm certified for SLICOT's
+        controller on the scaled plant (feasibility and the controller LMI only; the
+        controller is the LMI's).  Where the LMI finds none there, or SLICOT none at
+        all, it minimises γ, knowing the previous controller's level on the new scaled
+        plant: the minimisation starts in the frame of the Riccati solutions at that
+        level and gives up where it stops above it (``gamma_abort``, unless the options
+        set one); where it fails on an over-relaxed plant, the plain D-step's plant is
+        used instead.  With
         ``"lmi"`` and no ``constraints`` or ``K0``, the first iterate is the central
         controller at 1 % above the level the first LMI K-step certified (SLICOT
         ``sb10ad`` at that fixed γ, certified on the plant; the LMI's own controller
@@ -1068,6 +1080,41 @@ def _kstep_options(opts: MusynOptions):
             else HinfsynOptions(riccati_search="bisection"))
 
 
+def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base):
+    """The LMI K-step at a level fixed in advance: ``(1 + _LEVEL_RELAX)`` times the γ
+    certified for SLICOT's controller (Riccati bisection, 0.03-0.15 s here); the
+    controller is the LMI's (feasibility, then the controller LMI, at that level),
+    certified on ``PD``.  Returns ``(result, tried)``: ``result`` None where SLICOT
+    finds no controller (``tried`` False) or the LMI none at the level, within
+    ``_LEVEL_LED_RECOVERIES`` recoveries (``tried`` True); the caller then runs the γ
+    minimisation.
+
+    On the D-scaled plants of the distillation problem the γ minimisation is where the
+    LMI K-step loses its time and its reproducibility (9-70 s on 22 states, γ 1.0113 to
+    1.0298 on one plant across OpenBLAS kernels, measured 2026-11-26); at a level
+    fixed by a certified controller only a feasibility problem is left.
+    """
+    try:
+        ric = hinfsyn(PD, nmeas, ncon, method="riccati",
+                      options=replace(base, riccati_search="bisection"))
+    except LmiSuspensionError as exc:
+        logger.info("musyn: no Riccati level for the LMI K-step (%s)", exc)
+        return None, False
+    if not np.isfinite(ric.gamma):
+        return None, False
+    level = float(ric.gamma) * (1.0 + _LEVEL_RELAX)
+    bounded = replace(base, gamma=level,
+                      max_recoveries=min(int(base.max_recoveries), _LEVEL_LED_RECOVERIES))
+    try:
+        res = hinfsyn(PD, nmeas, ncon, method="lmi", options=bounded)
+    except LmiSuspensionError as exc:
+        logger.info("musyn: the LMI K-step at %.6g failed (%s); γ minimisation", level, exc)
+        return None, True
+    return replace(res, warnings=tuple(res.warnings) + (
+        f"LMI K-step at {level:.6g}, {_LEVEL_RELAX:.1%} above the γ certified for "
+        f"SLICOT's controller ({ric.gamma:.6g})",)), True
+
+
 def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
             gamma_prev: float = float("nan")):
     """H∞ synthesis on the scaled plant. With ``method="best"`` the Riccati route runs on
@@ -1087,6 +1134,16 @@ def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
             # (an over-relaxed distillation plant: 53 s of failing controller LMIs,
             # 2026-11-25)
             base = replace(base, gamma_abort=hint * (1 + _KSTEP_RTOL))
+        if opts.method == "lmi" and hint is not None and base.gamma is None:
+            led, tried = _level_led_lmi(hinfsyn, PD, nmeas, ncon, base)
+            if led is not None:
+                return led
+            if tried:
+                # the LMI found no controller at a level a certified one achieves: its
+                # γ minimisation gets the same bounded effort (caps3 plants 4 and 7:
+                # 10 s and a clean failure instead of 33 s and 20 s)
+                base = replace(base, max_recoveries=min(int(base.max_recoveries),
+                                                        _LEVEL_LED_RECOVERIES))
         return hinfsyn(PD, nmeas, ncon, method=opts.method, options=base, probes=probes,
                        level_hint=hint)
     results, errors = [], []
