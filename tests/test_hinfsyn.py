@@ -419,6 +419,32 @@ def test_fixed_gamma():
         hinfsyn(P, 1, 1, options=HinfsynOptions(gamma=0.9 * ref))
 
 
+def test_fixed_level_falls_back_to_the_identity_frame(monkeypatch):
+    """Injected: where Clarabel fails in the frame of the Riccati solutions at a fixed
+    level, the feasibility problem is solved in the identity frame and the controller
+    still certifies at the level (distillation plant, S&P 2005 Sec. 8.12.4, at 1.2 x
+    the LMI optimum computed here)."""
+    from lmi_suspension.examples import skogestad_distillation
+    from lmi_suspension.synthesis import lmi as L
+
+    ex = skogestad_distillation()
+    level = 1.2 * hinfsyn(ex.P, 2, 2).gamma_lower
+    framed = []
+    gamma_lmi = L.gamma_lmi
+
+    def failing_in_a_frame(P, opts, gamma=None, frame=None):
+        framed.append(frame is not None)
+        if frame is not None:
+            raise SolverError("injected")
+        return gamma_lmi(P, opts, gamma=gamma)
+
+    monkeypatch.setattr(L, "gamma_lmi", failing_in_a_frame)
+    res = hinfsyn(ex.P, 2, 2, options=HinfsynOptions(gamma=level))
+    assert framed == [True, False]
+    assert_certified(res, ex.P)
+    assert res.gamma <= level * (1 + 1e-6)
+
+
 def test_bad_input_raises_typed_errors():
     P = scalar_plant(1.0)
     with pytest.raises(NonFiniteError):

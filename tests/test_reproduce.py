@@ -217,11 +217,16 @@ def test_every_controller_file_holds_both_realizations(run):
     assert meta["description"] == "stand-in refined"
 
 
+def _bump_at_25ms(K):
+    """The quick run's bump and ``K``'s loop on it at 25 ms, simulated directly."""
+    road = bump(t_end=R._QUICK.bump_t_end, dt=R._QUICK.road_dt)
+    return road, simulate(K, road, delay=0.025, dt=R._QUICK.sim_dt)
+
+
 @pytest.mark.slow
 def test_constrained_row_reports_commanded_force_and_the_sampled_loop(run):
     c = run.summary.controller("mu_constrained")
-    road = bump(t_end=R._QUICK.bump_t_end, dt=R._QUICK.road_dt)
-    direct = simulate(K_CONSTRAINED, road, delay=0.025, dt=R._QUICK.sim_dt)
+    road, direct = _bump_at_25ms(K_CONSTRAINED)
     assert c.peak_u_command[-1] == pytest.approx(np.max(np.abs(direct.u_command)), rel=1e-12)
     sampled = simulate_sampled(discretise_controller(K_CONSTRAINED, 1e-3), road, delay=0.025)
     assert c.sampled_peak_z3dd[-1] == pytest.approx(np.max(np.abs(sampled.z3dd)), rel=1e-12)
@@ -233,8 +238,7 @@ def test_constrained_row_reports_commanded_force_and_the_sampled_loop(run):
 @pytest.mark.slow
 def test_refined_row_is_simulated_and_certified_with_the_paper_weights(run):
     c = run.summary.controller("mu_refined")
-    road = bump(t_end=R._QUICK.bump_t_end, dt=R._QUICK.road_dt)
-    direct = simulate(K_REFINED, road, delay=0.025, dt=R._QUICK.sim_dt)
+    _road, direct = _bump_at_25ms(K_REFINED)
     assert c.peak_z3dd[-1] == pytest.approx(np.max(np.abs(direct.z3dd)), rel=1e-12)
     assert len(c.sampled_peak_z3dd) == len(c.delays)
     assert "certify refined" in run.calls

@@ -1080,6 +1080,12 @@ def _kstep_options(opts: MusynOptions):
             else HinfsynOptions(riccati_search="bisection"))
 
 
+def _level_led_effort(options):
+    """``options`` with at most ``_LEVEL_LED_RECOVERIES`` recoveries."""
+    return replace(options, max_recoveries=min(int(options.max_recoveries),
+                                               _LEVEL_LED_RECOVERIES))
+
+
 def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base):
     """The LMI K-step at a level fixed in advance: ``(1 + _LEVEL_RELAX)`` times the γ
     certified for SLICOT's controller (Riccati bisection, 0.03-0.15 s here); the
@@ -1103,10 +1109,9 @@ def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base):
     if not np.isfinite(ric.gamma):
         return None, False
     level = float(ric.gamma) * (1.0 + _LEVEL_RELAX)
-    bounded = replace(base, gamma=level,
-                      max_recoveries=min(int(base.max_recoveries), _LEVEL_LED_RECOVERIES))
     try:
-        res = hinfsyn(PD, nmeas, ncon, method="lmi", options=bounded)
+        res = hinfsyn(PD, nmeas, ncon, method="lmi",
+                      options=replace(_level_led_effort(base), gamma=level))
     except LmiSuspensionError as exc:
         logger.info("musyn: the LMI K-step at %.6g failed (%s); γ minimisation", level, exc)
         return None, True
@@ -1142,8 +1147,7 @@ def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
                 # the LMI found no controller at a level a certified one achieves: its
                 # γ minimisation gets the same bounded effort (caps3 plants 4 and 7:
                 # 10 s and a clean failure instead of 33 s and 20 s)
-                base = replace(base, max_recoveries=min(int(base.max_recoveries),
-                                                        _LEVEL_LED_RECOVERIES))
+                base = _level_led_effort(base)
         return hinfsyn(PD, nmeas, ncon, method=opts.method, options=base, probes=probes,
                        level_hint=hint)
     results, errors = [], []

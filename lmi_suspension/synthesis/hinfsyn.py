@@ -474,7 +474,7 @@ def _refined_gamma_lmi(Ps: GeneralizedPlant, opts: HinfsynOptions,
 def _fixed_level_lmi(Ps: GeneralizedPlant, sc: PlantScaling, gamma: float,
                      opts: HinfsynOptions):
     """The elimination LMIs at the fixed level ``gamma`` (plant units): the errors scaled
-    so that the level is near 1 in scaled units (:meth:`PlantScaling.with_error_scale`),
+    so that the level is near 1 in scaled units (:func:`_unit_gamma`),
     the Lyapunov variables relative to the frame of the Riccati solutions at the level
     (:func:`~.lmi.riccati_frame`), else the identity frame.  Returns ``(solution,
     plant, scaling)``.
@@ -487,8 +487,7 @@ def _fixed_level_lmi(Ps: GeneralizedPlant, sc: PlantScaling, gamma: float,
     another run, and on the distillation plant scaled by ``(0.001 s + 1)/(s + 1)``,
     Clarabel fails in the frame at every level tried (0.3 % to 10 % above).
     """
-    Ps, sc = sc.with_error_scale(Ps, gamma * sc.gamma_factor)
-    g = gamma * sc.gamma_factor
+    Ps, sc, g, _ = _unit_gamma(Ps, sc, gamma * sc.gamma_factor, [])
     frame = _lmi.riccati_frame(Ps, g)
     if frame is not None:
         try:
