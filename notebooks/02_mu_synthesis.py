@@ -127,9 +127,9 @@ plt.show()
 #
 # D-K stops where neither of its two partial steps improves the bound, and on this problem
 # that is above 1 (near 1.003 when run on). After the loop, `musyn` therefore searches the
-# parameters of the D-scale fits directly (`dscale_search`, at most 100 K-steps by
-# default): Nelder-Mead on the certified γ of a Riccati K-step on each scaled plant. Its
-# result is the last row (`dscale_search`).
+# parameters of the D-scale fits directly (`dscale_search`, at most 200 K-steps by
+# default): Nelder-Mead on the level a Riccati K-step achieves on each scaled plant; the
+# best point's controller is certified. Its result is the last row (`dscale_search`).
 
 # %%
 opts = MusynOptions(max_iter=6, patience=6, min_improvement=0.0, method="best", n_dense=200)

@@ -363,49 +363,75 @@ def test_options_are_validated_and_frozen():
 
 def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     """search_dscales started from the D-step of the plain H∞ controller (µ 1.18): its
-    first point is the next D-K step; every point is a certified norm, so the best one
-    bounds µ of its loop at every frequency (checked on a dense, wider grid) and the
-    number of K-steps stays within the bound."""
+    first point is the next D-K step; it searches SLICOT's level, and the best point's
+    controller is certified, so its norm bounds µ of its loop at every frequency (checked
+    on a dense, wider grid) and the number of K-steps stays within the bound."""
     from lmi_suspension.mu.dfit import scaled_plant
+    from lmi_suspension.mu.dk import _SEARCH_LEVELS, _best_certified
     from lmi_suspension.mu.dsearch import search_dscales
-    from lmi_suspension.mu.dk import _riccati_balanced
     from lmi_suspension.synthesis import HinfsynOptions
+    from lmi_suspension.synthesis.hinfsyn import riccati_level
 
     ex = skogestad_distillation()
     w = np.logspace(-3, 3, 61)
-    bisection = HinfsynOptions(riccati_search="bisection")
+    bisection = HinfsynOptions(riccati_search="bisection", riccati_rtol=1e-6)
     K1 = hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati", options=bisection).K
     mu1 = mussv(freqresp(lft(ex.P, K1), w), ex.blk)
     calls = []
 
-    def kstep(PD):
+    def level(PD):
         calls.append(PD.nstates)
-        return _riccati_balanced(_hinfsyn, PD, ex.nmeas, ex.ncon, bisection).K
+        return riccati_level(PD, ex.nmeas, ex.ncon, bisection)
 
-    found = search_dscales(ex.P, ex.nmeas, ex.ncon, [(1, 1), (1, 1), (2, 2)], w,
-                           mu1.d_blocks, 0.2 + mu1.upper / mu1.upper.max(), 4, kstep,
-                           max_evals=40)
+    def controller(PD, g):
+        return _best_certified(_hinfsyn, PD, PD, ex.nmeas, ex.ncon, bisection,
+                               [g * (1 + r) for r in _SEARCH_LEVELS])[0]
+
+    args = (ex.P, ex.nmeas, ex.ncon, [(1, 1), (1, 1), (2, 2)], w, mu1.d_blocks,
+            0.2 + mu1.upper / mu1.upper.max(), 4, level, controller)
+    found = search_dscales(*args, max_evals=40)
     assert len(calls) == found.evaluations <= 40
-    # the start is D-K's second iteration (1.0344); 1.0143 measured after 40 K-steps
-    # (2026-11-24; the day before, 1.0109 after 20: Nelder-Mead's path turns on rounding
-    # in the K-steps, and this one first explores points up to 1.5)
-    assert found.gamma_start == pytest.approx(1.0344, rel=2e-3)
-    assert found.gamma < found.gamma_start * (1 - 5e-3)
+    # the start is D-K's second iteration (µ 1.0344 for the bisection's controller)
+    assert found.level_start == pytest.approx(1.0344, rel=2e-3)
+    assert found.level < found.level_start * (1 - 5e-3)
     assert found.dfit.orders == ((4,), (4,), (0,))  # the normalised block stays 1
     PD = scaled_plant(ex.P, ex.nmeas, ex.ncon, found.dfit, [(1, 1), (1, 1), (2, 2)])
     assert found.gamma == pytest.approx(float(hinfnorm(lft(PD, found.K))[0]), rel=1e-9)
+    # the controllers sit above the level SLICOT achieves, at most 1 % (_SEARCH_LEVELS)
+    assert found.level <= found.gamma <= found.level * 1.01 * (1 + 1e-6)
     mu = mussv(freqresp(lft(ex.P, found.K), np.logspace(-4, 4, 201)), ex.blk)
     assert np.max(mu.upper) <= found.gamma * (1 + 1e-4)
-    # a target level ends the search at the first point certified below it
-    early = search_dscales(ex.P, ex.nmeas, ex.ncon, [(1, 1), (1, 1), (2, 2)], w,
-                           mu1.d_blocks, 0.2 + mu1.upper / mu1.upper.max(), 4, kstep,
-                           max_evals=20, target=found.gamma_start * (1 - 1e-3))
-    assert early.gamma < found.gamma_start * (1 - 1e-3) and early.evaluations < 20
+    # a target level ends the search at the first point below it
+    early = search_dscales(*args, max_evals=20, target=found.level_start * (1 - 1e-3))
+    assert early.level < found.level_start * (1 - 1e-3) and early.evaluations < 20
     # nothing to search: constant scalings, or every block normalised
-    assert search_dscales(ex.P, ex.nmeas, ex.ncon, [(1, 1), (1, 1), (2, 2)], w,
-                          mu1.d_blocks, None, 0, kstep) is None
-    assert search_dscales(ex.P, ex.nmeas, ex.ncon, [(1, 1), (1, 1), (2, 2)], w,
-                          np.ones((3, w.size)), None, 4, kstep) is None
+    assert search_dscales(*args[:6], None, 0, level, controller) is None
+    assert search_dscales(*args[:5], np.ones((3, w.size)), None, 4, level, controller) is None
+
+
+def test_riccati_level_is_where_slicot_stops_finding_a_controller():
+    """riccati_level on the distillation problem (S&P 2005, Sec. 8.12.4; γ_opt ≈ 1.18,
+    their first D-K iteration): SLICOT's sb10ad finds no stabilising controller just
+    below it, and just above it gives one whose closed-loop norm, computed here by
+    hinfnorm, is at that level."""
+    from lmi_suspension.errors import LmiSuspensionError
+    from lmi_suspension.synthesis import HinfsynOptions
+    from lmi_suspension.synthesis.hinfsyn import riccati_level
+
+    ex = skogestad_distillation()
+    g = riccati_level(ex.P, ex.nmeas, ex.ncon, HinfsynOptions(riccati_rtol=1e-6))
+    assert g == pytest.approx(1.18, abs=0.01)
+    below = g * (1 - 1e-5)
+    try:
+        K = hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati",
+                    options=HinfsynOptions(gamma=below)).K
+    except LmiSuspensionError:
+        pass
+    else:  # a controller SLICOT returns below the level must not stabilise the loop
+        assert np.max(np.real(lft(ex.P, K).poles())) >= 0
+    res = hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati",
+                  options=HinfsynOptions(gamma=g * 1.003))
+    assert float(hinfnorm(lft(ex.P, res.K))[0]) <= g * 1.003 * (1 + 1e-6)
 
 
 def test_initial_controller_takes_the_place_of_the_first_k_step():
