@@ -582,10 +582,11 @@ def test_lmi_k_step_at_the_level_of_a_certified_controller():
     assert calls == [("lmi", None)]
 
 
-def test_lmi_k_step_falls_back_to_the_gamma_minimisation():
-    """Injected failures: where SLICOT finds no controller, or the LMI none at the fixed
-    level, the K-step is the γ minimisation with the previous controller's level as its
-    hint."""
+def test_lmi_k_step_without_a_level_falls_back_and_without_a_controller_fails():
+    """Injected failures: where SLICOT finds no controller, the K-step is the γ
+    minimisation with the previous controller's level as its hint; where the LMI finds
+    none at the fixed level, the K-step fails with a SolverError that names the level
+    (D-K then takes the plain D-step's plant or ends) and no γ minimisation runs."""
     from types import SimpleNamespace
 
     from lmi_suspension.errors import InfeasibleError, SolverError
@@ -605,10 +606,15 @@ def test_lmi_k_step_falls_back_to_the_gamma_minimisation():
                 raise InfeasibleError("injected")
             return "minimisation"
 
-        assert _k_step(fake, P, 2, 2, MusynOptions(), 1.25) == "minimisation"
-        assert seen[-1] == ("lmi", None, 1.25)
-        if failing == "fixed":
-            assert ("lmi", pytest.approx(1.2 * 1.003), None) in seen
+        if failing == "riccati":
+            assert _k_step(fake, P, 2, 2, MusynOptions(), 1.25) == "minimisation"
+            assert seen[-1] == ("lmi", None, 1.25)
+        else:
+            with pytest.raises(SolverError, match="no controller at 1.2036") as err:
+                _k_step(fake, P, 2, 2, MusynOptions(), 1.25)
+            assert isinstance(err.value.__cause__, InfeasibleError)
+            assert seen[-1] == ("lmi", pytest.approx(1.2 * 1.003), None)
+            assert ("lmi", None, 1.25) not in seen
 
 
 def test_a_plain_rebuild_is_not_repeated_by_a_restart():

@@ -1108,44 +1108,44 @@ def _kstep_options(opts: MusynOptions):
             else HinfsynOptions(riccati_search="bisection"))
 
 
-def _level_led_effort(options):
-    """``options`` with at most ``_LEVEL_LED_RECOVERIES`` recoveries."""
-    return replace(options, max_recoveries=min(int(options.max_recoveries),
-                                               _LEVEL_LED_RECOVERIES))
-
-
 def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base):
     """The LMI K-step at a level fixed in advance: ``(1 + _LEVEL_RELAX)`` times the γ
     certified for SLICOT's controller (Riccati bisection, 0.03-0.15 s here); the
     controller is the LMI's (feasibility, then the controller LMI, at that level),
-    certified on ``PD``.  Returns ``(result, tried)``: ``result`` None where SLICOT
-    finds no controller (``tried`` False) or the LMI none at the level, within
-    ``_LEVEL_LED_RECOVERIES`` recoveries (``tried`` True); the caller then runs the γ
-    minimisation.
+    certified on ``PD``.  Returns None where SLICOT finds no controller (the caller
+    then runs the γ minimisation); raises :class:`SolverError` where the LMI finds none
+    at the level within ``_LEVEL_LED_RECOVERIES`` recoveries.
 
     On the D-scaled plants of the distillation problem the γ minimisation is where the
     LMI K-step loses its time and its reproducibility (9-70 s on 22 states, γ 1.0113 to
     1.0298 on one plant across OpenBLAS kernels, measured 2026-11-26); at a level
-    fixed by a certified controller only a feasibility problem is left.
+    fixed by a certified controller only a feasibility problem is left.  Where even
+    that fails, the γ minimisation is not tried: on the same problem it took 10-17 s
+    per K-step there, and default ``musyn`` (8 OpenBLAS kernel and thread rows) ended
+    at µ 0.9648-0.9772 in 25-75 s with it, at 0.9638-0.9727 in 19-43 s without it
+    (D-K then goes on from the plain D-step's plant, or ends and the D-scale search
+    starts from the best iterate; measured 2026-11-26).
     """
     try:
         ric = hinfsyn(PD, nmeas, ncon, method="riccati",
                       options=replace(base, riccati_search="bisection"))
     except LmiSuspensionError as exc:
         logger.info("musyn: no Riccati level for the LMI K-step (%s)", exc)
-        return None, False
+        return None
     if not np.isfinite(ric.gamma):
-        return None, False
+        return None
     level = float(ric.gamma) * (1.0 + _LEVEL_RELAX)
     try:
         res = hinfsyn(PD, nmeas, ncon, method="lmi",
-                      options=replace(_level_led_effort(base), gamma=level))
+                      options=replace(base, gamma=level, max_recoveries=min(
+                          int(base.max_recoveries), _LEVEL_LED_RECOVERIES)))
     except LmiSuspensionError as exc:
-        logger.info("musyn: the LMI K-step at %.6g failed (%s); γ minimisation", level, exc)
-        return None, True
+        raise SolverError(f"the LMI found no controller at {level:.6g}, "
+                          f"{_LEVEL_RELAX:.1%} above the γ certified for SLICOT's "
+                          f"controller ({ric.gamma:.6g}): {exc}") from exc
     return replace(res, warnings=tuple(res.warnings) + (
         f"LMI K-step at {level:.6g}, {_LEVEL_RELAX:.1%} above the γ certified for "
-        f"SLICOT's controller ({ric.gamma:.6g})",)), True
+        f"SLICOT's controller ({ric.gamma:.6g})",))
 
 
 def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
@@ -1168,14 +1168,9 @@ def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
             # 2026-11-25)
             base = replace(base, gamma_abort=hint * (1 + _KSTEP_RTOL))
         if opts.method == "lmi" and hint is not None and base.gamma is None:
-            led, tried = _level_led_lmi(hinfsyn, PD, nmeas, ncon, base)
+            led = _level_led_lmi(hinfsyn, PD, nmeas, ncon, base)
             if led is not None:
                 return led
-            if tried:
-                # the LMI found no controller at a level a certified one achieves: its
-                # γ minimisation gets the same bounded effort (caps3 plants 4 and 7:
-                # 10 s and a clean failure instead of 33 s and 20 s)
-                base = _level_led_effort(base)
         return hinfsyn(PD, nmeas, ncon, method=opts.method, options=base, probes=probes,
                        level_hint=hint)
     results, errors = [], []
