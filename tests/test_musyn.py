@@ -523,7 +523,8 @@ def test_lmi_k_step_knows_the_previous_controllers_level():
 
     seen = []
 
-    def fake(PD, nmeas, ncon, method, options, probes=(), level_hint=None):
+    def fake(PD, nmeas, ncon, method, options, probes=(), level_hint=None,
+             feasibility_recoveries=None):
         if method == "riccati" and not probes:
             # the level of the level-led LMI K-step (asked without probes): none, so the
             # γ minimisation runs
@@ -596,8 +597,12 @@ def test_lmi_k_step_without_a_level_falls_back_and_without_a_controller_fails():
     for failing in ("riccati", "fixed"):
         seen = []
 
-        def fake(PD, nmeas, ncon, method, options, probes=(), level_hint=None):
+        def fake(PD, nmeas, ncon, method, options, probes=(), level_hint=None,
+             feasibility_recoveries=None):
             seen.append((method, options.gamma, level_hint))
+            if method == "lmi" and options.gamma is not None:
+                # the feasibility problem gets no Clarabel recovery (_LEVEL_LED_RECOVERIES)
+                assert feasibility_recoveries == 0
             if method == "riccati":
                 if failing == "riccati":
                     raise SolverError("injected")

@@ -168,8 +168,8 @@ def hinfsyn(P, nmeas: int, ncon: int, *, method: str = "lmi",
 
 def _hinfsyn(P, nmeas: int, ncon: int, method: str = "lmi",
              options: HinfsynOptions | None = None, *, probes: tuple = (),
-             bracket: tuple | None = None, level_hint: float | None = None
-             ) -> HinfsynResult:
+             bracket: tuple | None = None, level_hint: float | None = None,
+             feasibility_recoveries: int | None = None) -> HinfsynResult:
     """:func:`hinfsyn` with the Riccati route's search heuristics that ``musyn`` uses:
     ``probes``, relative levels ``(1 + r) γ`` whose suboptimal controllers are also
     certified when the γ-optimal one certifies above its own γ (the formulas are
@@ -178,7 +178,10 @@ def _hinfsyn(P, nmeas: int, ncon: int, method: str = "lmi",
     wrong), and ``level_hint``, a level some controller is known to achieve (in D-K,
     the previous controller's on the new scaled plant): the LMI route's γ
     minimisation then starts in the frame of the Riccati solutions at that level
-    (:func:`~lmi_suspension.synthesis.lmi.riccati_frame`)."""
+    (:func:`~lmi_suspension.synthesis.lmi.riccati_frame`); and, at a fixed γ,
+    ``feasibility_recoveries``, the Clarabel recoveries of the LMI route's feasibility
+    problem (default ``options.max_recoveries``; the controller LMI keeps those):
+    ``musyn`` takes 0 where a failure only means the next K-step variant."""
     opts = HinfsynOptions() if options is None else options
     if not isinstance(opts, HinfsynOptions):
         raise ParameterError("options must be a HinfsynOptions instance")
@@ -200,7 +203,7 @@ def _hinfsyn(P, nmeas: int, ncon: int, method: str = "lmi",
         raise ParameterError(f"probes must be positive relative steps, got {probes!r}")
     if method == "riccati":
         return _hinfsyn_riccati(G, opts, t0, tuple(probes), bracket)
-    return _hinfsyn_lmi(G, opts, t0, level_hint)
+    return _hinfsyn_lmi(G, opts, t0, level_hint, feasibility_recoveries)
 
 
 # --------------------------------------------------------------------------- riccati
@@ -524,7 +527,8 @@ def _fixed_level_lmi(Ps: GeneralizedPlant, sc: PlantScaling, gamma: float,
 
 
 def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float,
-                 level_hint: float | None = None) -> HinfsynResult:
+                 level_hint: float | None = None,
+                 feasibility_recoveries: int | None = None) -> HinfsynResult:
     warnings: list[str] = []
     G0 = _without_d22(G)
     if opts.scale:
@@ -556,7 +560,9 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float,
         g_base = max(sol.gamma, opts.gamma_atol)
     else:
         gamma_lower, earlier = None, []
-        sol, Ps, sc = _fixed_level_lmi(Ps, sc, float(opts.gamma), opts)
+        feasibility = opts if feasibility_recoveries is None else \
+            replace(opts, max_recoveries=int(feasibility_recoveries))
+        sol, Ps, sc = _fixed_level_lmi(Ps, sc, float(opts.gamma), feasibility)
         g_base = float(opts.gamma) * sc.gamma_factor
     warnings += list(sol.warnings)
     Ps, sc, g_base, (sol, *earlier) = _unit_gamma(Ps, sc, g_base, [sol] + earlier)
