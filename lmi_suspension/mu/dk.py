@@ -115,12 +115,13 @@ class MusynOptions:
         certified closed-loop γ.  From the second iteration on, the LMI K-step is
         posed at a level fixed in advance, 0.3 % above the norm certified for SLICOT's
         controller on the scaled plant (feasibility and the controller LMI only; the
-        controller is the LMI's).  Where the LMI finds none there, or SLICOT none at
-        all, it minimises γ, knowing the previous controller's level on the new scaled
-        plant: the minimisation starts in the frame of the Riccati solutions at that
-        level and gives up where it stops above it (``gamma_abort``, unless the options
-        set one); where it fails on an over-relaxed plant, the plain D-step's plant is
-        used instead.  With
+        controller is the LMI's).  Where the LMI finds none there, the K-step fails.
+        Where SLICOT finds none at all, it minimises γ, knowing the previous
+        controller's level on the new scaled plant: the minimisation starts in the
+        frame of the Riccati solutions at that level and gives up where it stops above
+        it (``gamma_abort``, unless the options set one).  Where a K-step fails on an
+        over-relaxed plant, the plain D-step's plant is used instead; elsewhere D-K
+        ends at the best iterate.  With
         ``"lmi"`` and no ``constraints`` or ``K0``, the first iterate is the central
         controller at 1 % above the level the first LMI K-step certified (SLICOT
         ``sb10ad`` at that fixed γ, certified on the plant; the LMI's own controller
@@ -945,10 +946,10 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
         last = riccati_level(PD, nmeas, ncon, options, bracket=bracket)
         return last
 
-    def controller(PD, level):
+    def controller(PD, g):
         plant = _gramian_balanced(PD)
         return _best_certified(hinfsyn, PD, PD if plant is None else plant, nmeas, ncon,
-                               options, [level * (1.0 + r) for r in _SEARCH_LEVELS])[0]
+                               options, [g * (1.0 + r) for r in _SEARCH_LEVELS])[0]
 
     t0 = time.perf_counter()
     found = search_dscales(G.sys, nmeas, ncon, _block_sizes(struct), omega, d_blocks,

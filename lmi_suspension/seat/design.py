@@ -63,7 +63,7 @@ logger = logging.getLogger(__name__)
 #: 1.28 / 1.19 / 1.26 / 1.46 × the physical limit 6.164 (at most 1.471 on a 2.5 ms grid
 #: over 0–25 ms; was 1.25–1.60 with acc_ref 3, u_max 3000, z_max 0.10, noise 0.5 mm,
 #: w_corner 13.5, w_rolloff 45, delay_order 2: 9.86 m/s² at 0 ms, 9.71 at 25 ms); peak
-#: peak x1 0.060 m (≤ 0.08); delay margin 0.216 s. What limits the two ends is different:
+#: x1 0.060 m (≤ 0.08); delay margin 0.216 s. What limits the two ends is different:
 #: at 0 ms the controller commands up to 2830 N and the 1500 N saturation sets the peak
 #: (3.3 m/s² without saturation); at 25 ms the peak is the linear loop's (8.2 m/s²
 #: unsaturated). Larger force scales lower the 25 ms peak, more x1 noise and a lower
