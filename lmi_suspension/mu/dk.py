@@ -120,8 +120,9 @@ class MusynOptions:
         controller's level on the new scaled plant: the minimisation starts in the
         frame of the Riccati solutions at that level and gives up where it stops above
         it (``gamma_abort``, unless the options set one).  Where a K-step fails on an
-        over-relaxed plant, the plain D-step's plant is used instead; elsewhere D-K
-        ends at the best iterate.  With
+        over-relaxed plant, the plain D-step's plant is used instead (and the
+        over-relaxation is halved, ``dscale_overrelax``); elsewhere D-K ends at the
+        best iterate.  With
         ``"lmi"`` and no ``constraints`` or ``K0``, the first iterate is the central
         controller at 1 % above the level the first LMI K-step certified (SLICOT
         ``sb10ad`` at that fixed γ, certified on the plant; the LMI's own controller
@@ -163,7 +164,11 @@ class MusynOptions:
         certificates are unchanged.  When an iterate is not the best so far, the next
         D-step starts again from the best iterate's own scalings (``α = 1`` once) and
         ``α`` is halved towards 1; if that restart does not beat the best iterate either,
-        the step after it is a plain one from where the loop is.
+        the step after it is a plain one from where the loop is.  ``α`` is halved as well
+        where the K-step fails on an over-relaxed plant: on the distillation problem the
+        LMI K-step failed on 3 over-relaxed plants in a row there, 2-3 s each (default
+        ``musyn`` in 15-26 s with the halving, 18-32 s without, over 4 OpenBLAS kernels
+        and 1 and 2 threads; measured 2026-11-26).
     dscale_search : int
         After the D-K loop, at most this many K-steps of a direct search on the
         parameters of the D-scale fits (order ``max_dfit_order``, started from the best
@@ -176,10 +181,11 @@ class MusynOptions:
         coincide share one fit.  The controller is kept only if its µ peak beats the
         best iterate's; ``0`` turns the search off.  Skipped for constant scalings
         (``max_dfit_order = 0``) and once ``mu_target`` is met; it stops as soon as a
-        level is below ``mu_target``.  Each K-step costs about 0.05 s on
+        level is below ``mu_target``.  Each K-step costs about 0.04 s on
         distillation's 22-state scaled plants; with 200, the default, the search ended
         at µ 0.965-0.977 where 100 ended at 0.974-0.982 (default ``musyn``, 8 OpenBLAS
-        kernel and thread rows, measured 2026-11-26).  Repeated-scalar blocks are
+        kernel and thread rows, measured 2026-11-26, level bisected to 1e-6; to 1e-4,
+        ``_SEARCH_LEVEL_RTOL``, 0.964-0.972).  Repeated-scalar blocks are
         searched with scalings ``d(s) I``, a restriction of their D matrices (still a
         valid bound).
     """
@@ -454,8 +460,9 @@ class _OverRelaxation:
     def plain_from(self, it: int) -> None:
         """The next plant was rebuilt from iterate ``it``'s plain D-step (its K-step
         failed on the over-relaxed one): what a restart from ``it`` would build, so a
-        restart is not repeated after it."""
+        restart is not repeated after it; α is halved towards 1, as after a restart."""
         self._restarted_from = it
+        self.alpha = 1.0 + (self.alpha - 1.0) / 2.0
 
     def fitted(self, magnitudes: list[np.ndarray]) -> None:
         """Record the fit the next scaled plant was built with."""
@@ -934,7 +941,7 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
     from ..synthesis.hinfsyn import riccati_level
 
     # the bisection search (its bracket follows the search) at free γ, whatever the
-    # loop's K-steps were given, down to a width below the search's own resolution
+    # loop's K-steps were given, down to the width _SEARCH_LEVEL_RTOL
     options = replace(_kstep_options(opts), riccati_search="bisection", gamma=None,
                       riccati_rtol=_SEARCH_LEVEL_RTOL)
 
@@ -1007,10 +1014,12 @@ def _gramian_balanced(PD: control.StateSpace) -> control.StateSpace | None:
 #: levels, relative to the lowest level SLICOT achieved on a Gramian-balanced realization,
 #: whose controllers are judged on the scaled plant itself (see :func:`_riccati_balanced`)
 _BALANCED_LEVELS = (0.0, 3e-4, 1e-3, 3e-3)
-#: width (relative) of the D-scale search's Riccati bisection: below the search's own
-#: resolution (its Nelder-Mead tolerance is 1e-6 relative), so that the searched level is
-#: SLICOT's verdict on the plant and not the bisection's grid
-_SEARCH_LEVEL_RTOL = 1e-6
+#: width (relative) of the D-scale search's Riccati bisection.  200 points of the search
+#: move the level by 1-2 %, so a grid of 1e-4 does not blur its path: from the 8 starts
+#: of the distillation runs (4 OpenBLAS kernels x 1, 2 threads) it ended at levels
+#: 0.9641-0.9720 with this width, 0.9635-0.9724 with 1e-6, in 7.5 s instead of 10.5 s
+#: (9 bisection steps from the search's ±3 % bracket instead of 16; measured 2026-11-26)
+_SEARCH_LEVEL_RTOL = 1e-4
 #: levels above the best point's, relative, whose SLICOT controllers the search certifies
 #: (the lowest certified one is returned); at the level itself they are ill-conditioned
 _SEARCH_LEVELS = (3e-4, 1e-3, 3e-3, 1e-2)
