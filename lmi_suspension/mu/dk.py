@@ -452,7 +452,7 @@ class _OverRelaxation:
             self._restarted_from = None
             return here, here.d_blocks
         self._restarted_from = best_it
-        self.alpha = 1.0 + (self.alpha - 1.0) / 2.0
+        self._halve()
         logger.info("musyn: iteration %d is not the best; next D-step from iteration %d, "
                     "over-relaxation %.3g", it, best_it, self.alpha)
         return self._best, self._best.d_blocks
@@ -462,6 +462,11 @@ class _OverRelaxation:
         failed on the over-relaxed one): what a restart from ``it`` would build, so a
         restart is not repeated after it; α is halved towards 1, as after a restart."""
         self._restarted_from = it
+        self._halve()
+
+    def _halve(self) -> None:
+        """α halved towards 1 (the over-relaxation overshot: a restart, or a failed
+        K-step on the over-relaxed plant)."""
         self.alpha = 1.0 + (self.alpha - 1.0) / 2.0
 
     def fitted(self, magnitudes: list[np.ndarray]) -> None:
