@@ -361,6 +361,38 @@ def test_options_are_validated_and_frozen():
         opts.max_iter = 3
 
 
+def test_best_certified_judges_the_controllers_of_every_realization_on_the_plant():
+    """_best_certified designs at each level on each realization it is given and keeps
+    the controller with the lowest norm certified on PD itself.  The synthesis is
+    injected: a static gain per (realization, level), so that the best one comes from
+    the second realization and another realization raises.  On PD (x' = -x + w + u,
+    z = y = x) the static gain k gives the loop 1/(s + 1 - k), norm 1/(1 - k)."""
+    from types import SimpleNamespace
+
+    from lmi_suspension.errors import InfeasibleError
+    from lmi_suspension.mu.dk import _best_certified
+    from lmi_suspension.synthesis import HinfsynOptions
+
+    PD = control.ss([[-1.0]], [[1.0, 1.0]], [[1.0], [1.0]], np.zeros((2, 2)))
+    balanced, broken = control.ss(PD), control.ss(PD)
+    gains = {(id(balanced), 1.0): 0.5, (id(balanced), 2.0): 0.2,
+             (id(PD), 1.0): -1.0, (id(PD), 2.0): 0.0}
+
+    def synthesis(plant, nmeas, ncon, method, options):
+        assert method == "riccati" and (nmeas, ncon) == (1, 1)
+        if plant is broken:
+            raise InfeasibleError("no controller on this realization")
+        return SimpleNamespace(K=control.ss([], [], [], [[gains[id(plant), options.gamma]]]))
+
+    K, CL, gamma = _best_certified(synthesis, PD, (broken, balanced, PD), 1, 1,
+                                   HinfsynOptions(), [1.0, 2.0])
+    assert float(K.D[0, 0]) == -1.0
+    assert gamma == pytest.approx(0.5, rel=1e-6)  # 1 / (1 - (-1))
+    assert float(hinfnorm(CL)[0]) == pytest.approx(gamma, rel=1e-9)
+    with pytest.raises(InfeasibleError):
+        _best_certified(synthesis, PD, (broken,), 1, 1, HinfsynOptions(), [1.0, 2.0])
+
+
 def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     """search_dscales started from the D-step of the plain H∞ controller (µ 1.18): its
     first point is the next D-K step; it searches SLICOT's level, and the best point's
@@ -384,7 +416,7 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
         return riccati_level(PD, ex.nmeas, ex.ncon, bisection)
 
     def controller(PD, g):
-        return _best_certified(_hinfsyn, PD, PD, ex.nmeas, ex.ncon, bisection,
+        return _best_certified(_hinfsyn, PD, (PD,), ex.nmeas, ex.ncon, bisection,
                                [g * (1 + r) for r in _SEARCH_LEVELS])[0]
 
     args = (ex.P, ex.nmeas, ex.ncon, [(1, 1), (1, 1), (2, 2)], w, mu1.d_blocks,
