@@ -365,7 +365,7 @@ def test_best_certified_judges_the_controllers_of_every_realization_on_the_plant
     """_best_certified designs at each level on each realization it is given and keeps
     the controller with the lowest norm certified on PD itself.  The synthesis is
     injected: a static gain per (realization, level), so that the best one comes from
-    the second realization and another realization raises.  On PD (x' = -x + w + u,
+    the last realization and the first one raises.  On PD (x' = -x + w + u,
     z = y = x) the static gain k gives the loop 1/(s + 1 - k), norm 1/(1 - k)."""
     from types import SimpleNamespace
 

@@ -1031,10 +1031,11 @@ _SEARCH_LEVEL_RTOL = 1e-4
 #: They are designed on the scaled plant and on its balanced realization: near the
 #: optimum SLICOT's controller misses its own level, by an amount that moves with the
 #: OpenBLAS kernel.  At the same best point (level 0.970688, reached from one start on
-#: Haswell and Sandybridge), the balanced realization's controllers certified +0.10 %
-#: and +0.99 % above it, the scaled plant's +0.10 % and +0.03 %: either realization
-#: alone gives a spread of 0.9 % between the kernels, the better of the two 0.07 %
-#: (measured 2026-11-26)
+#: Haswell and Sandybridge), the balanced realization's best controllers certified
+#: +0.10 % and +0.99 % above it, the scaled plant's +0.10 % and +0.03 %: 0.9 % apart
+#: between the kernels with the balanced realization alone, 0.07 % with both (measured
+#: 2026-11-26).  The balanced one stays because on other scaled plants it is the only
+#: one SLICOT solves near the optimum (:func:`_gramian_balanced`)
 _SEARCH_LEVELS = (3e-4, 1e-3, 3e-3, 1e-2)
 
 
