@@ -451,3 +451,43 @@ def test_scaled_plant_refuses_a_reduction_that_changes_the_response(monkeypatch)
     assert PD.nstates == P.nstates + 2 * dfit.fits[0].nstates
     wt = np.logspace(-2, 2, 9)
     np.testing.assert_allclose(resp(PD, wt), _pointwise(P, dfit, wt), rtol=1e-8)
+
+
+def test_equal_fits_have_equal_parameters():
+    """The roots fix a fit's parameters (``_canonical``): four real roots pair into two
+    sections in three ways and the sections can be listed in either order, and every
+    one of the six parameter vectors maps to one vector with the same magnitude.
+
+    Reference: the roots chosen here (those of a distillation D-scale fit, in scaled
+    frequency) and the magnitude of the product of their factors, evaluated directly.
+    """
+    from lmi_suspension.mu.dfit import _canonical, _model_logmag, _side_roots
+
+    def section(p, q):  # (ln wn, ln zeta) of (u + p)(u + q)
+        wn = np.sqrt(p * q)
+        return [np.log(wn), np.log((p + q) / (2 * wn))]
+
+    zeros, poles = (335.0, 2.6, 0.154, 0.045), (40.0, 1.5, 0.3, 0.01)
+    pairings = [((0, 1), (2, 3)), ((0, 2), (1, 3)), ((0, 3), (1, 2))]
+    u2 = np.logspace(-6, 6, 49) ** 2
+    exact = 0.3 + sum(0.5 * np.log(u2 + z * z) for z in zeros) \
+        - sum(0.5 * np.log(u2 + p * p) for p in poles)
+    canon = []
+    for (a, b), (c, d) in pairings:
+        for flip in (False, True):
+            s1, s2 = section(zeros[a], zeros[b]), section(zeros[c], zeros[d])
+            num = s2 + s1 if flip else s1 + s2
+            theta = np.array([0.3] + num + section(poles[0], poles[3]) + section(poles[1], poles[2]))
+            np.testing.assert_allclose(_model_logmag(theta, 4, u2), exact, atol=1e-12)
+            c_theta = _canonical(theta, 4)
+            np.testing.assert_allclose(_model_logmag(c_theta, 4, u2), exact, atol=1e-12)
+            np.testing.assert_allclose(np.sort(-_side_roots(c_theta[1:5], 4).real), sorted(zeros),
+                                       rtol=1e-12)
+            canon.append(c_theta)
+    assert len({tuple(np.round(t, 12)) for t in canon}) == 1
+    # a complex pair and an odd order keep their roots as well
+    theta = np.array([0.0, np.log(3.0), np.log(0.2), np.log(7.0), np.log(2.0), np.log(0.5),
+                      np.log(0.1)])
+    c_theta = _canonical(theta, 3)
+    np.testing.assert_allclose(_model_logmag(c_theta, 3, u2), _model_logmag(theta, 3, u2),
+                               atol=1e-12)

@@ -167,9 +167,49 @@ def _roots_to_side_params(roots: np.ndarray, order: int) -> np.ndarray:
         p, q = max(p, 1e-300), max(q, 1e-300)
         wn = np.sqrt(p * q)
         params += [np.log(wn), np.log((p + q) / (2 * wn))]
+    # sections by falling natural frequency, so that equal polynomials have equal params
+    sections = sorted(zip(params[0:2 * n2:2], params[1:2 * n2:2]), reverse=True)
+    params = [x for section in sections for x in section]
     if has1:
         params += [np.log(max(-real.pop(0), 1e-300))] if real else [0.0]
     return np.array(params[: order])
+
+
+def _side_roots(params: np.ndarray, order: int) -> np.ndarray:
+    """Roots of :func:`_poly_from_params`, section by section (no expansion)."""
+    n2, has1 = _structure(order)
+    roots = []
+    for i in range(n2):
+        wn, zeta = np.exp(params[2 * i]), np.exp(params[2 * i + 1])
+        if zeta < 1.0:
+            r = wn * complex(-zeta, np.sqrt(1.0 - zeta * zeta))
+            roots += [r, r.conjugate()]
+        else:  # the larger root first, the smaller from the product wn^2 (no cancellation)
+            big = -wn * (zeta + np.sqrt(zeta * zeta - 1.0))
+            roots += [big, wn * wn / big]
+    if has1:
+        roots.append(-np.exp(params[2 * n2]))
+    return np.array(roots, dtype=complex)
+
+
+def _canonical(theta: np.ndarray, order: int) -> np.ndarray:
+    """The parameters of the same fit in one canonical form: real roots paired with
+    their neighbours and sections sorted (:func:`_roots_to_side_params`).
+
+    A fit's roots do not fix its parameters: four real roots pair into two sections in
+    three ways, and sections can be listed in any order.  Which one the least-squares
+    fit returns depends on its start and on roundoff: the same D-scale magnitudes gave
+    pairings {335, 0.154}, {2.6, 0.045} under one OpenBLAS kernel and {335, 2.6},
+    {0.154, 0.045} under three others (measured 2026-11-26), and the D-scale search,
+    which moves the parameters, then took another path on each.
+    """
+    if order < 2:
+        return theta
+    sides = [_roots_to_side_params(_side_roots(p, order), order)
+             for p in (theta[1:1 + order], theta[1 + order:])]
+    if any(q.size != order or not np.all(np.isfinite(q)) for q in sides):
+        return theta
+    return np.concatenate([theta[:1], *sides])
 
 
 # ----------------------------------------------------------------------------- fitting
@@ -311,7 +351,7 @@ def _fit_sequence(omega, mag, w, max_order, stop=None):
                     best, best_cost = cand, c
         if best is None:
             raise SolverError(f"no finite magnitude fit of order {order} was found")
-        theta = best
+        theta = _canonical(best, order)
         fits.append((theta, omega0))
         if stop is not None and stop(order, theta, u2, logmag):
             break
