@@ -395,9 +395,10 @@ def test_best_certified_judges_the_controllers_of_every_realization_on_the_plant
 
 def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     """search_dscales started from the D-step of the plain H∞ controller (µ 1.18): its
-    first point is the next D-K step; it searches SLICOT's level, and the best point's
-    controller is certified, so its norm bounds µ of its loop at every frequency (checked
-    on a dense, wider grid) and the number of K-steps stays within the bound."""
+    first point is the next D-K step; it searches SLICOT's level, every point it accepts
+    is checked, and the best point's controller is certified, so its norm bounds µ of
+    its loop at every frequency (checked on a dense, wider grid) and the number of
+    levels stays within the bound."""
     from lmi_suspension.mu.dfit import scaled_plant
     from lmi_suspension.mu.dk import _SEARCH_LEVELS, _best_certified
     from lmi_suspension.mu.dsearch import search_dscales
@@ -409,11 +410,17 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     bisection = HinfsynOptions(riccati_search="bisection", riccati_rtol=1e-6)
     K1 = hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati", options=bisection).K
     mu1 = mussv(freqresp(lft(ex.P, K1), w), ex.blk)
-    calls = []
+    calls, checks = [], []
 
-    def level(PD):
+    def level(PD, bracket, rtol):
         calls.append(PD.nstates)
-        return riccati_level(PD, ex.nmeas, ex.ncon, bisection)
+        return riccati_level(PD, ex.nmeas, ex.ncon, dataclasses.replace(bisection, riccati_rtol=rtol),
+                             bracket=bracket)
+
+    def check(PD, g):
+        checks.append(g)
+        return hinfsyn(PD, ex.nmeas, ex.ncon, method="riccati",
+                       options=dataclasses.replace(bisection, gamma=1.001 * g)).gamma
 
     def controller(PD, g):
         return _best_certified(_hinfsyn, PD, (PD,), ex.nmeas, ex.ncon, bisection,
@@ -421,11 +428,13 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
 
     args = (ex.P, ex.nmeas, ex.ncon, [(1, 1), (1, 1), (2, 2)], w, mu1.d_blocks,
             0.2 + mu1.upper / mu1.upper.max(), 4, level, controller)
-    found = search_dscales(*args, max_evals=40)
-    assert len(calls) == found.evaluations <= 40
+    found = search_dscales(*args, check=check, max_evals=60)
+    assert len(calls) == found.evaluations <= 60
     # the start is D-K's second iteration (µ 1.0344 for the bisection's controller)
     assert found.level_start == pytest.approx(1.0344, rel=2e-3)
     assert found.level < found.level_start * (1 - 5e-3)
+    # the start and the trial steps are checked, the difference quotients are not
+    assert 2 <= len(checks) < found.evaluations / 4
     assert found.dfit.orders == ((4,), (4,), (0,))  # the normalised block stays 1
     PD = scaled_plant(ex.P, ex.nmeas, ex.ncon, found.dfit, [(1, 1), (1, 1), (2, 2)])
     assert found.gamma == pytest.approx(float(hinfnorm(lft(PD, found.K))[0]), rel=1e-9)
@@ -433,12 +442,51 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     assert found.level <= found.gamma <= found.level * 1.01 * (1 + 1e-6)
     mu = mussv(freqresp(lft(ex.P, found.K), np.logspace(-4, 4, 201)), ex.blk)
     assert np.max(mu.upper) <= found.gamma * (1 + 1e-4)
-    # a target level ends the search at the first point below it
-    early = search_dscales(*args, max_evals=20, target=found.level_start * (1 - 1e-3))
-    assert early.level < found.level_start * (1 - 1e-3) and early.evaluations < 20
+    # a target level ends the search at the first accepted point below it
+    early = search_dscales(*args, max_evals=60, target=found.level_start * (1 - 1e-3))
+    assert early.level < found.level_start * (1 - 1e-3) and early.evaluations < 60
     # nothing to search: constant scalings, or every block normalised
     assert search_dscales(*args[:6], None, 0, level, controller) is None
     assert search_dscales(*args[:5], np.ones((3, w.size)), None, 4, level, controller) is None
+
+
+def test_dscale_search_rejects_a_point_whose_controller_misses_its_level():
+    """A check that fails on purpose (every controller certifies 2 % above its level)
+    rejects every point, the start included: no result, and no level beyond the
+    start's is spent on a search that has nowhere to go."""
+    from lmi_suspension.mu.dsearch import search_dscales
+    from lmi_suspension.synthesis import HinfsynOptions
+    from lmi_suspension.synthesis.hinfsyn import riccati_level
+
+    ex = skogestad_distillation()
+    w = np.logspace(-3, 3, 31)
+    opts = HinfsynOptions(riccati_search="bisection")
+    K1 = hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati", options=opts).K
+    mu1 = mussv(freqresp(lft(ex.P, K1), w), ex.blk)
+    calls = []
+
+    def level(PD, bracket, rtol):
+        calls.append(1)
+        return riccati_level(PD, ex.nmeas, ex.ncon, opts, bracket=bracket)
+
+    found = search_dscales(ex.P, ex.nmeas, ex.ncon, [(1, 1), (1, 1), (2, 2)], w,
+                           mu1.d_blocks, None, 2, level, lambda PD, g: None,
+                           check=lambda PD, g: 1.02 * g, max_evals=30)
+    assert found is None and len(calls) == 1
+
+
+def test_least_norm_combination_of_gradients():
+    """The descent direction at a kink: the least-norm point of the convex hull of the
+    sampled gradients.  References: for g1 = (1, 1), g2 = (1, -1) it is (1, 0) (the
+    midpoint, by symmetry); for two opposite gradients it is 0 (a stationary kink,
+    like |x| at 0); for one gradient, the gradient."""
+    from lmi_suspension.mu.dsearch import _least_norm
+
+    np.testing.assert_allclose(_least_norm(np.array([[1.0, 1.0], [1.0, -1.0]])), [1.0, 0.0],
+                               atol=1e-6)
+    np.testing.assert_allclose(_least_norm(np.array([[2.0, 0.0], [-1.0, 0.0]])), [0.0, 0.0],
+                               atol=1e-6)
+    np.testing.assert_allclose(_least_norm(np.array([[0.3, -4.0]])), [0.3, -4.0], rtol=1e-9)
 
 
 def test_riccati_level_is_where_slicot_stops_finding_a_controller():

@@ -9,8 +9,10 @@ The loop alternates three exchangeable steps and keeps the diagnostics of each:
    (:func:`fit_dscales`, :func:`scaled_plant`).
 
 After the loop, a direct search on the D-scale fit parameters with the K-step inside
-(:mod:`.dsearch`) continues from the best iterate where D-K stalls. The best iterate
-(lowest µ peak) is returned, never a worse last one. Repeated real scalar
+(:mod:`.dsearch`), started from the first iterate's D-step, goes on to a local minimum of
+the bound where D-K stalls. The best iterate (lowest µ peak) is returned, never a worse
+last one; the peak of the returned µ upper bound is refined with the LMI bound
+(:func:`_final_bounds`). Repeated real scalar
 blocks are treated as complex in the D-K loop (a conservative but standard simplification);
 the returned µ bounds use the true mixed structure.
 """
@@ -170,24 +172,28 @@ class MusynOptions:
         ``musyn`` in 15-26 s with the halving, 18-32 s without, over 4 OpenBLAS kernels
         and 1 and 2 threads; measured 2026-11-26).
     dscale_search : int
-        After the D-K loop, at most this many K-steps of a direct search on the
-        parameters of the D-scale fits (order ``max_dfit_order``, started from the best
-        iterate's scalings): Nelder-Mead on the level SLICOT's Riccati synthesis achieves
-        on each scaled plant, the best point's controller certified at the end
-        (:mod:`.dsearch`).  D-K stops where neither of its partial steps improves the
-        bound, which is not a minimum of the bound over both (distillation: D-K settles
-        near 1.003; from the third iterate the search certifies 0.968, below the 0.974
-        of the book's optimal third-order scalings).  Blocks whose optimal scalings
-        coincide share one fit.  The controller is kept only if its µ peak beats the
-        best iterate's; ``0`` turns the search off.  Skipped for constant scalings
-        (``max_dfit_order = 0``) and once ``mu_target`` is met; it stops as soon as a
-        level is below ``mu_target``.  Each K-step costs about 0.04 s on
-        distillation's 22-state scaled plants; with 200, the default, the search ended
-        at µ 0.965-0.977 where 100 ended at 0.974-0.982 (default ``musyn``, 8 OpenBLAS
-        kernel and thread rows, measured 2026-11-26, level bisected to 1e-6; to 1e-4,
-        ``_SEARCH_LEVEL_RTOL``, 0.964-0.972).  Repeated-scalar blocks are
-        searched with scalings ``d(s) I``, a restriction of their D matrices (still a
-        valid bound).
+        After the D-K loop, at most this many levels (K-steps) of a direct search on
+        the parameters of the D-scale fits (order ``max_dfit_order``), started from the
+        D-step of the *first* iterate: a descent method for the piecewise-smooth level
+        SLICOT's Riccati synthesis achieves on each scaled plant (BFGS on difference
+        quotients, least-norm steps at kinks, every accepted point checked by a
+        certified controller; :mod:`.dsearch`), the best point's controller certified at
+        the end.  D-K stops where neither of its partial steps improves the bound,
+        which is not a minimum of the bound over both (distillation: D-K settles near
+        0.99-1.003, the book's optimal third-order scalings give 0.974).  The first
+        iterate is the same on every machine, later ones are not (the LMI K-steps'
+        controllers are not unique), and the search ends near a local minimum, so its
+        result does not depend on the machine: default ``musyn`` on distillation gave
+        µ 0.959417-0.959536 under four OpenBLAS kernels and 1 and 2 threads, in
+        23-28 s (the previous Nelder-Mead search from the best iterate: 0.9636-0.9716;
+        measured 2026-11-26).  Blocks whose optimal scalings coincide share one fit.
+        The controller is kept only if its µ peak beats the best iterate's; ``0``
+        turns the search off.  Skipped for constant scalings (``max_dfit_order = 0``),
+        with constraints, and once ``mu_target`` is met; it stops as soon as an
+        accepted level is below ``mu_target``.  Each level costs about 0.05 s on
+        distillation's 22-state scaled plants.  Repeated-scalar blocks are searched
+        with scalings ``d(s) I``, a restriction of their D matrices (still a valid
+        bound).
     """
 
     max_iter: int = 8
@@ -376,6 +382,50 @@ def _mu_bounds(CL, struct, omega, rng, M=None):
     M = freqresp(CL, omega) if M is None else M
     mu = mussv(M, struct, omega=omega, rng=rng)
     return mu, float(np.max(mu.lower))
+
+
+#: frequencies whose upper bound the final µ refines at a time (see _final_bounds)
+_REFINE_BATCH = 8
+
+
+def _final_bounds(CL, struct: BlockStructure, omega: np.ndarray, rng):
+    """µ bounds of ``CL`` over ``omega``, the upper bound's peak exact.
+
+    ``mussv``'s fast upper bound minimises ``σ̄(D M D⁻¹)`` by BFGS, which stalls short
+    of the minimum where singular values coalesce, as they do across the flat µ of an
+    optimised loop: on the distillation loop of the D-scale search it read
+    0.95947-0.96010 under four OpenBLAS kernels and 1 and 2 threads, where the LMI
+    upper bound (a convex problem solved to its optimum) read 0.959465-0.959531, equal
+    to the lower bound (measured 2026-11-26).  So the frequencies are refined with the
+    LMI bound in falling order of the fast bound, until no unrefined one is above the
+    largest refined bound; elsewhere the fast bound stays (it is no smaller).
+    """
+    from .bounds import MussvOptions, mussv
+
+    M = freqresp(CL, omega)
+    mu = mussv(M, struct, omega=omega, rng=rng)
+    if mu.method == "lmi":
+        return mu
+    upper, fields = np.array(mu.upper), {k: np.array(getattr(mu, k)) for k in
+                                         ("D_left", "D_right", "G", "d_blocks")}
+    order = np.argsort(-upper, kind="stable")
+    top = 0.0
+    for start in range(0, order.size, _REFINE_BATCH):
+        batch = order[start:start + _REFINE_BATCH]
+        if upper[batch[0]] <= top:
+            break
+        exact = mussv(M[:, :, batch], struct, method="lmi", omega=omega[batch],
+                      options=MussvOptions(compute_lower=False))
+        better = batch[np.asarray(exact.upper) < upper[batch]]
+        kept = np.asarray(exact.upper) < upper[batch]
+        upper[better] = np.asarray(exact.upper)[kept]
+        for k, v in fields.items():
+            v[..., better] = np.asarray(getattr(exact, k))[..., kept]
+        top = max(top, float(np.max(upper[batch])))
+    k_peak = int(np.argmax(upper))
+    # (equal bounds can cross by roundoff once the upper one is exact)
+    return replace(mu, upper=upper, lower=np.minimum(mu.lower, upper), peak=float(upper[k_peak]),
+                   peak_omega=float(omega[k_peak]), **fields)
 
 
 def _scaled_peak(fits, M: np.ndarray, omega: np.ndarray, struct: BlockStructure) -> float:
@@ -694,8 +744,9 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
 
         improved = best is None or mu_peak < best[0] * (1 - opts.min_improvement)
         if (best is None or mu_peak < best[0]) and all(c.met for c in certs):
+            if best is None:  # where the D-scale search starts (see ``dscale_search``)
+                first_dstep = (mu.d_blocks, upper)
             best = (mu_peak, K, it)
-            best_dstep = (mu.d_blocks, upper)
         elif best is None:
             raise InfeasibleError("the first K-step's controller violates " + "; ".join(
                 f"{c.name} ({c.achieved:.6g})" for c in certs if not c.met))
@@ -787,7 +838,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     if opts.dscale_search and best[0] >= opts.mu_target and constraints:
         logger.info("musyn: no D-scale search with constraints (its K-step is Riccati's)")
     elif opts.dscale_search and best[0] >= opts.mu_target:
-        found = _search_stage(G, nmeas, ncon, dk_struct, omega, best_dstep, opts, rng,
+        found = _search_stage(G, nmeas, ncon, dk_struct, omega, first_dstep, opts, rng,
                               index=len(history) + 1, hinfsyn=hinfsyn)
         if found is not None:
             history.append(found)
@@ -801,7 +852,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     CL_full = lft(G, K)
     CL = balanced_statespace(_mu_part(CL_full, struct))
     dense = _dense_grid(omega, int(opts.n_dense), history[best_it - 1].peak_omega, CL)
-    final, _ = _mu_bounds(CL, struct, dense, rng)
+    final = _final_bounds(CL, struct, dense, rng)
     reduced_from = None
     if opts.reduce_order is not None and int(opts.reduce_order) < K.nstates:
         K_red = _try_reduce(K, int(opts.reduce_order))
@@ -810,7 +861,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
             CL_red = balanced_statespace(_mu_part(CL_red_full, struct))
             if np.all(np.real(CL_red.poles()) < 0) and all(
                     c.met for c in _certificates(constraints, CL_red_full)):
-                final_red, _ = _mu_bounds(CL_red, struct, dense, rng)
+                final_red = _final_bounds(CL_red, struct, dense, rng)
                 if np.max(final_red.upper) <= np.max(final.upper) * (1 + opts.reduce_mu_tol):
                     reduced_from = K.nstates
                     K, CL, CL_full, final = K_red, CL_red, CL_red_full, final_red
@@ -945,18 +996,16 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
         return None  # per-block magnitudes expected; constant scalings requested
     from ..synthesis.hinfsyn import riccati_level
 
-    # the bisection search (its bracket follows the search) at free γ, whatever the
-    # loop's K-steps were given, down to the width _SEARCH_LEVEL_RTOL
-    options = replace(_kstep_options(opts), riccati_search="bisection", gamma=None,
-                      riccati_rtol=_SEARCH_LEVEL_RTOL)
+    # the bisection search at free γ, whatever the loop's K-steps were given
+    options = replace(_kstep_options(opts), riccati_search="bisection", gamma=None)
 
-    last = None  # the last point's γ level: neighbouring points have similar ones
+    def level(PD, bracket, rtol):
+        return riccati_level(PD, nmeas, ncon, replace(options, riccati_rtol=rtol),
+                             bracket=bracket)
 
-    def level(PD):
-        nonlocal last
-        bracket = None if last is None else (0.97 * last, 1.03 * last)
-        last = riccati_level(PD, nmeas, ncon, options, bracket=bracket)
-        return last
+    def check(PD, g):
+        return hinfsyn(PD, nmeas, ncon, method="riccati",
+                       options=replace(options, gamma=g * (1.0 + _CHECK_LEVEL))).gamma
 
     def controller(PD, g):
         balanced = _gramian_balanced(PD)
@@ -967,7 +1016,7 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
     t0 = time.perf_counter()
     found = search_dscales(G.sys, nmeas, ncon, _block_sizes(struct), omega, d_blocks,
                            0.2 + upper / np.max(upper), int(opts.max_dfit_order), level,
-                           controller, max_evals=int(opts.dscale_search),
+                           controller, check=check, max_evals=int(opts.dscale_search),
                            target=float(opts.mu_target))
     if found is None:
         logger.info("musyn: D-scale search found no controller from the best iterate")
@@ -976,8 +1025,8 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
     CL = lft(G, found.K)
     if not np.all(np.real(CL.poles()) < 0):
         return None
-    M = freqresp(CL, omega)
-    mu, lower_peak = _mu_bounds(CL, struct, omega, rng, M)
+    mu = _final_bounds(CL, struct, omega, rng)
+    lower_peak = float(np.max(mu.lower))
     upper = np.asarray(mu.upper)
     k_peak = int(np.argmax(upper))
     logger.info("musyn: D-scale search, %d K-steps in %.1f s: level %.5f -> %.5f, "
@@ -1020,12 +1069,9 @@ def _gramian_balanced(PD: control.StateSpace) -> control.StateSpace | None:
 #: levels, relative to the lowest level SLICOT achieved on a Gramian-balanced realization,
 #: whose controllers are judged on the scaled plant itself (see :func:`_riccati_balanced`)
 _BALANCED_LEVELS = (0.0, 3e-4, 1e-3, 3e-3)
-#: width (relative) of the D-scale search's Riccati bisection.  200 points of the search
-#: move the level by 1-2 %, so a grid of 1e-4 does not blur its path: from the 8 starts
-#: of the distillation runs (4 OpenBLAS kernels x 1, 2 threads) it ended at levels
-#: 0.9641-0.9720 with this width, 0.9635-0.9724 with 1e-6, in 7.5 s instead of 10.5 s
-#: (9 bisection steps from the search's ±3 % bracket instead of 16; measured 2026-11-26)
-_SEARCH_LEVEL_RTOL = 1e-4
+#: level, relative to a point's own, of the SLICOT controller whose certified norm
+#: checks each point the D-scale search accepts (:mod:`.dsearch`)
+_CHECK_LEVEL = 1e-3
 #: levels above the best point's, relative, whose SLICOT controllers the search certifies
 #: (the lowest certified one is returned); at the level itself they are ill-conditioned.
 #: They are designed on the scaled plant and on its balanced realization: near the
