@@ -167,9 +167,6 @@ def _roots_to_side_params(roots: np.ndarray, order: int) -> np.ndarray:
         p, q = max(p, 1e-300), max(q, 1e-300)
         wn = np.sqrt(p * q)
         params += [np.log(wn), np.log((p + q) / (2 * wn))]
-    # sections by falling natural frequency, so that equal polynomials have equal params
-    sections = sorted(zip(params[0:2 * n2:2], params[1:2 * n2:2]), reverse=True)
-    params = [x for section in sections for x in section]
     if has1:
         params += [np.log(max(-real.pop(0), 1e-300))] if real else [0.0]
     return np.array(params[: order])
@@ -208,10 +205,15 @@ def _canonical(theta: np.ndarray, order: int) -> np.ndarray:
     """
     if order < 2:
         return theta
-    sides = [_roots_to_side_params(_side_roots(p, order), order)
-             for p in (theta[1:1 + order], theta[1 + order:])]
-    if any(q.size != order or not np.all(np.isfinite(q)) for q in sides):
-        return theta
+    n2 = order // 2
+    sides = []
+    for p in (theta[1:1 + order], theta[1 + order:]):
+        q = _roots_to_side_params(_side_roots(p, order), order)
+        if q.size != order or not np.all(np.isfinite(q)):
+            return theta
+        # sections by falling natural frequency
+        sections = sorted(zip(q[0:2 * n2:2], q[1:2 * n2:2]), reverse=True)
+        sides.append(np.concatenate([[x for sec in sections for x in sec], q[2 * n2:]]))
     return np.concatenate([theta[:1], *sides])
 
 
