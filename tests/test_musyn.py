@@ -751,6 +751,10 @@ def test_an_iterate_whose_mu_lower_bound_beats_its_gamma_is_flagged(monkeypatch)
     assert not any("exceeds the certified γ" in w for h in loop for w in h.warnings)
     # what musyn reports for it is µ of its own loop, not the wrong γ
     assert res.mu_peak >= search.mu_lower_peak * (1 - 1e-3) > search.gamma
+    # and the returned loop's µ on the dense grid witnesses it as well
+    assert res.best_iteration == search.index
+    assert any("on the dense grid" in w and "exceeds the certified γ" in w
+               for w in res.history[-1].warnings)
 
 
 def test_lmi_dk_starts_from_the_central_controller():
