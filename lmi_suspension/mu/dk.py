@@ -189,11 +189,13 @@ class MusynOptions:
         which is not a minimum of the bound over both (distillation: D-K settles near
         0.99-1.003, the book's optimal third-order scalings give 0.974).  The first
         iterate is the same on every machine, later ones are not (the LMI K-steps'
-        controllers are not unique), and the search ends near a local minimum, so its
-        result does not depend on the machine: default ``musyn`` on distillation gave
-        µ 0.959417-0.959536 under four OpenBLAS kernels and 1 and 2 threads, in
-        23-28 s (the previous Nelder-Mead search from the best iterate: 0.9636-0.9716;
-        measured 2026-11-26).  Blocks whose optimal scalings coincide share one fit.
+        controllers are not unique), and the search ends near a local minimum, which
+        small differences of its path mostly lead back to: default ``musyn`` on
+        distillation gave µ 0.959417-0.959536 under four OpenBLAS kernels and 1 and 2
+        threads, in 18-29 s (the previous Nelder-Mead search from the best iterate:
+        0.9636-0.9716).  Mostly, not always: on 51- and 71-point grids the Haswell and
+        Sandybridge kernels ended in different local minima, 0.2 % and 0.5 % apart
+        (measured 2026-11-26).  Blocks whose optimal scalings coincide share one fit.
         The controller is kept only if its µ peak beats the best iterate's; ``0``
         turns the search off.  Skipped for constant scalings (``max_dfit_order = 0``),
         with constraints, and once ``mu_target`` is met; it stops as soon as an
