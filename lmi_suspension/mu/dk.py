@@ -425,8 +425,8 @@ def _final_bounds(CL, struct: BlockStructure, omega: np.ndarray, rng):
             break
         exact = mussv(M[:, :, batch], struct, method="lmi", omega=omega[batch],
                       options=MussvOptions(compute_lower=False))
-        better = batch[np.asarray(exact.upper) < upper[batch]]
-        kept = np.asarray(exact.upper) < upper[batch]
+        kept = np.asarray(exact.upper) < upper[batch]  # the fast bound is kept elsewhere
+        better = batch[kept]
         upper[better] = np.asarray(exact.upper)[kept]
         for k, v in fields.items():
             v[..., better] = np.asarray(getattr(exact, k))[..., kept]

@@ -303,6 +303,8 @@ def search_dscales(P, nmeas: int, ncon: int, block_sizes, omega, d_blocks, weigh
             x, f = theta0, level_start
             g = gradient(x, f)
             H = np.eye(x.size)
+            if g is None:
+                reason = "no gradient at the start"
             while g is not None:
                 d = -H @ g
                 if g @ d >= 0:
