@@ -836,3 +836,35 @@ def test_default_lmi_dk_on_distillation_goes_below_one():
     assert res.mu_peak <= best.gamma * (1 + 1e-3)
     assert res.mu_lower_peak >= 0.99 * res.mu_peak
     assert np.all(res.CL.poles().real < 0)
+
+
+def test_final_bounds_peak_is_the_lmi_bound_peak(monkeypatch):
+    """_final_bounds refines the fast upper bound with the LMI bound where it sets the
+    peak.  A stalled fast bound is injected (mussv's fast result inflated by 1 %, as
+    BFGS stalls on flat optimised loops); the reference is mussv's LMI upper bound at
+    every frequency of the same loop (the plain H∞ controller on distillation, 41
+    points): the refined peak equals its largest value, and no bound exceeds the
+    fast one."""
+    from lmi_suspension.mu import bounds
+    from lmi_suspension.mu.dk import _final_bounds
+
+    ex = skogestad_distillation()
+    w = np.logspace(-3, 3, 41)
+    CL = lft(ex.P, hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati").K)
+    exact = mussv(freqresp(CL, w), ex.blk, method="lmi")
+    real = bounds.mussv
+
+    def stalled(M, blk, *, method="auto", **kw):
+        res = real(M, blk, method=method, **kw)
+        if method == "lmi":
+            return res
+        upper = 1.01 * np.asarray(res.upper)
+        return dataclasses.replace(res, upper=upper, peak=float(np.max(upper)))
+
+    monkeypatch.setattr(bounds, "mussv", stalled)
+    fast = stalled(freqresp(CL, w), ex.blk)
+    final = _final_bounds(CL, fast.blk, w, np.random.default_rng(0))
+    assert fast.peak == pytest.approx(1.01 * float(np.max(exact.upper)), rel=1e-6)
+    assert final.peak == pytest.approx(float(np.max(exact.upper)), rel=1e-6)
+    assert np.all(np.asarray(final.upper) <= np.asarray(fast.upper) * (1 + 1e-12))
+    assert np.all(np.asarray(final.lower) <= np.asarray(final.upper))

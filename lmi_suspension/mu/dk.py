@@ -1038,7 +1038,7 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
                            controller, check=check, max_evals=int(opts.dscale_search),
                            target=float(opts.mu_target))
     if found is None:
-        logger.info("musyn: D-scale search found no controller from the best iterate")
+        logger.info("musyn: D-scale search found no controller from the first iterate")
         return None
     t1 = time.perf_counter()
     CL = lft(G, found.K)
@@ -1215,8 +1215,8 @@ def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base):
     that fails, the γ minimisation is not tried: on the same problem it took 10-17 s
     per K-step there, and default ``musyn`` (8 OpenBLAS kernel and thread rows) ended
     at µ 0.9648-0.9772 in 25-75 s with it, at 0.9638-0.9727 in 19-43 s without it
-    (D-K then goes on from the plain D-step's plant, or ends and the D-scale search
-    starts from the best iterate; measured 2026-11-26).
+    (D-K then goes on from the plain D-step's plant, or ends; the D-scale search then
+    started from the best iterate; measured 2026-11-26).
     """
     try:
         ric = hinfsyn(PD, nmeas, ncon, method="riccati",
