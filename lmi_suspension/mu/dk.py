@@ -12,9 +12,10 @@ After the loop, a direct search on the D-scale fit parameters with the K-step in
 (:mod:`.dsearch`), started from the first iterate's D-step, goes on to a local minimum of
 the bound where D-K stalls. The best iterate (lowest µ peak) is returned, never a worse
 last one; the peak of the returned µ upper bound is refined with the LMI bound
-(:func:`_final_bounds`). Repeated real scalar
-blocks are treated as complex in the D-K loop (a conservative but standard simplification);
-the returned µ bounds use the true mixed structure.
+(:func:`_final_bounds`).  Real scalar blocks are treated as complex in the loop unless
+``MusynOptions.complexify`` is False: then each D-step computes the mixed-µ D and G
+scalings, and G is fitted and absorbed into the scaled plant (D-G-K, :mod:`.gfit`,
+experimental).  The returned µ bounds use the true mixed structure either way.
 """
 
 from __future__ import annotations
@@ -37,6 +38,7 @@ from ..lti.plant import GeneralizedPlant, lft
 from ..lti.scaling import balanced_statespace
 from .blocks import BlockStructure
 from .dsearch import search_dscales
+from .interval import interval_bound
 
 logger = logging.getLogger(__name__)
 
@@ -81,6 +83,24 @@ _BOUNDS_RTOL = 1e-3
 #: 0.966751 fell below the loop's µ 0.967552 (``method="best"``, SkylakeX kernel, 2
 #: threads; measured 2026-11-26)
 _DENSE_BOUNDS_RTOL = 2e-4
+#: largest |ĝ| fitted in D-G-K.  Where a real block barely matters, the optimal ĝ runs
+#: off to 1e6 (the mass-spring loops of tests/test_dgk.py, away from the µ peak); its
+#: bound's disc |x - jĝ| <= (1 + ĝ²)^(1/2) is then nearly the half-plane it tends to,
+#: which 10 already covers to within 5 % of its radius
+_G_CLIP = 10.0
+#: floor of a block's D magnitude in D-G-K, relative to its largest over the grid: the
+#: mixed bound's optimum drives a real block's D to zero where the parameter cannot
+#: act (with G finite, so ĝ = G/d² runs off), and a log-magnitude fit cannot follow
+_D_FLOOR = 1e-2
+#: slack of the interval certificate of the returned µ over its dense-grid peak
+#: (``MusynResult.mu_bound``): on the distillation loops a fixed scaling certifies a
+#: level 0.6 % above µ 1 % of frequency away from its point, so each 0.1 % of slack
+#: saves splits (one LMI bound each)
+_SUP_RTOL = 1e-3
+#: splits of that certificate, where the scaled loop's γ does not already bound µ within
+#: _SUP_RTOL: on distillation's returned loop 100 splits (12 s) left it 1.3 % above
+#: the grid peak, where γ was 8e-5 above (measured 2026-11-27), so few are spent
+_SUP_SPLITS = 20
 
 
 def _bound_check(gamma: float, mu_lower: float, what: str,
@@ -203,6 +223,17 @@ class MusynOptions:
         distillation's 22-state scaled plants.  Repeated-scalar blocks are searched
         with scalings ``d(s) I``, a restriction of their D matrices (still a valid
         bound).
+    complexify : bool
+        Treat real scalar blocks (``[-r, 0]``) as complex in the loop (complex D-K, the
+        conservative cover of a real parameter by a disc; the default while D-G-K is
+        experimental).  With ``False`` they stay real: each D-step computes the
+        mixed-µ scalings D and G, and the G of each real block is fitted and absorbed
+        into the scaled plant with D's fit (D-G-K, Young 1996; :mod:`.gfit`).  Either way the returned bounds use the true structure.  In D-G-K
+        an iterate's ``gamma`` is the H∞ norm of its D-G-scaled plant at the level of
+        the previous µ peak (below 1 certifies that level; it is not itself a bound of
+        µ), the D-steps are plain (``dscale_overrelax`` is not used) and there is no
+        D-scale search; the per-frequency µ bounds with real blocks are LMIs, so each
+        D-step costs more than a complex one.
     """
 
     max_iter: int = 8
@@ -219,6 +250,7 @@ class MusynOptions:
     stop_on_kstep_regression: bool = True
     dscale_overrelax: float = 2.0
     dscale_search: int = 200
+    complexify: bool = True
 
     def __post_init__(self):
         if int(self.max_iter) < 1 or int(self.patience) < 1:
@@ -307,15 +339,31 @@ class MusynResult:
         The best controller found (lowest µ peak).
     CL : control.StateSpace
         ``F_l(P, K)``.
-    mu_peak, mu_lower_peak : float
-        Peaks of the µ upper and lower bounds of ``CL`` over the dense grid (see
-        ``MusynOptions.n_dense``), with the true (mixed) block structure.
+    mu_peak : float
+        Peak of the µ upper bound of ``CL`` over the dense grid (see
+        ``MusynOptions.n_dense``), with the true (mixed) block structure; its largest
+        values are the LMI bound (exact to 1e-6), elsewhere the fast bound (no smaller).
     peak_omega : float
-        Frequency of the upper-bound peak, rad/s.
+        Frequency of that peak, rad/s.
+    mu_bound : float
+        An upper bound of µ of ``CL`` at **every** frequency, ``0`` to ``∞``: the lower
+        of (a) the dense grid's bounds certified over each interval between and beyond
+        its points (:func:`~lmi_suspension.mu.interval_bound`, at most 0.1 % above
+        ``mu_peak`` where its splits suffice) and (b) the H∞ norm certified for the
+        returned controller on its D-scaled plant (the iterate's ``gamma``), where that
+        is consistent with the dense grid (no lower bound above it, no grid peak above
+        it).  ``mu_bound / mu_peak - 1`` says how far off the grid µ may rise.
+    mu_lower_peak : float
+        Peak of the µ lower bound over the dense grid (a lower bound of ``sup_ω µ``).
     mu : MussvResult
         The bounds over the dense grid.
     history : tuple of MusynIteration
-        One record per iteration.
+        One record per iteration, each the object the callback received (records are
+        complete when reported and never amended).
+    warnings : tuple of str
+        Findings of the checks of the returned loop made after the loop (a µ lower bound
+        on the dense grid above the γ certified for that controller on its scaled
+        plant: one of the two certificates is then wrong).
     best_iteration : int
         Index of the iteration whose controller is returned.
     stop_reason : str
@@ -344,6 +392,8 @@ class MusynResult:
     seconds: float = 0.0
     omega: np.ndarray = field(default_factory=lambda: np.zeros(0))
     certificates: tuple = ()
+    warnings: tuple = ()
+    mu_bound: float = float("nan")
 
     def __iter__(self):
         return iter((self.K, self.CL, self.mu_peak, self))
@@ -655,7 +705,10 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     if lyapunov_scales is not None and len(tuple(lyapunov_scales)) != len(constraints):
         raise ParameterError(f"lyapunov_scales must hold one scale per constraint "
                              f"({len(constraints)}), got {lyapunov_scales!r}")
-    dk_struct = _complexified(struct)
+    # D-G-K keeps real blocks real (their G scalings absorbed into the scaled plant,
+    # :mod:`.gfit`); complexify=True treats them as complex discs, as D-K always did
+    mixed = not opts.complexify and any(b.is_real for b in struct.blocks)
+    dk_struct = struct if mixed else _complexified(struct)
     given = None if K0 is None else _initial_controller(K0, G, struct, constraints)
     omega = default_omega(G) if omega is None else as_finite_array(omega, "omega").ravel()
     if omega.size < 3 or np.any(omega <= 0) or np.any(np.diff(omega) <= 0):
@@ -667,7 +720,8 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     stop_reason = f"reached max_iter={opts.max_iter}"
     since_best = 0
     K_prev = None
-    relax = _OverRelaxation(float(opts.dscale_overrelax))
+    # (over-relaxation extrapolates D alone; D-G-K steps are plain)
+    relax = _OverRelaxation(1.0 if mixed else float(opts.dscale_overrelax))
     gamma_next = None  # K_prev's norm on the next scaled plant, when the D-step has it
     scales = lyapunov_scales  # the constrained K-step's, searched once, then reused
     plain_next = None  # the plain D-step's (fit, plant) when the next plant is over-relaxed
@@ -792,6 +846,12 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
             weights = 0.2 + upper_s / peak_s
 
             def scaled(d):
+                if mixed:  # the D-only scaled peak is no test of a D-G fit
+                    d = _floored(d)
+                    fit = fit_dscales(omega, d, max_order=opts.max_dfit_order,
+                                      rtol=opts.dfit_rtol, weights=weights)
+                    return fit, _gscaled(G.sys, nmeas, ncon, fit, struct, free, mu, d,
+                                         peak_s, omega, weights)
                 fit = fit_dscales(omega, d, max_order=opts.max_dfit_order,
                                   rtol=opts.dfit_rtol, weights=weights,
                                   mu_check=lambda fits: _scaled_peak(fits, M_s, omega, dk_struct),
@@ -828,8 +888,8 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
             mu_lower_peak=lower_peak, peak_omega=peak_omega,
             dfit_orders=orders, controller_order=K.nstates, seconds_k=t1 - t0,
             seconds_d=t2 - t1, seconds_fit=t4 - t3,
-            warnings=tuple(syn.warnings) + _bound_check(float(syn.gamma), lower_peak,
-                                                        f"iteration {it}"),
+            warnings=tuple(syn.warnings) + (() if mixed and it > 1 else _bound_check(
+                float(syn.gamma), lower_peak, f"iteration {it}")),
             gamma_prev=gamma_prev, K=K, certificates=certs)
         history.append(record)
         K_prev = K_ref
@@ -846,6 +906,8 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
 
     if opts.dscale_search and best[0] >= opts.mu_target and constraints:
         logger.info("musyn: no D-scale search with constraints (its K-step is Riccati's)")
+    elif opts.dscale_search and best[0] >= opts.mu_target and mixed:
+        logger.info("musyn: no D-scale search with real blocks (it searches D alone)")
     elif opts.dscale_search and best[0] >= opts.mu_target:
         found = _search_stage(G, nmeas, ncon, dk_struct, omega, first_dstep, opts, rng,
                               index=len(history) + 1, hinfsyn=hinfsyn)
@@ -879,22 +941,30 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
                                 np.max(final_red.upper), np.max(final.upper))
     upper = np.asarray(final.upper)
     k_peak = int(np.argmax(upper))
+    checks: tuple = ()
+    mu_bound = float("inf")
     if reduced_from is None:
         # the dense grid reaches below the design grid, where a certificate computed on
-        # the scaled plant can fail: the returned loop's µ is the witness
-        record = history[best_it - 1]
-        found = _bound_check(record.gamma, float(np.max(final.lower)),
-                             f"iteration {best_it} on the dense grid (at "
-                             f"{float(dense[int(np.argmax(final.lower))]):.3g} rad/s)",
-                             rtol=_DENSE_BOUNDS_RTOL)
-        if found:
-            history[best_it - 1] = replace(record, warnings=record.warnings + found)
+        # the scaled plant can fail: the returned loop's µ is the witness.  Its record
+        # was reported already, so the finding goes to the result, not into the record.
+        gamma = history[best_it - 1].gamma
+        checks = _bound_check(gamma, float(np.max(final.lower)),
+                              f"iteration {best_it} on the dense grid (at "
+                              f"{float(dense[int(np.argmax(final.lower))]):.3g} rad/s)",
+                              rtol=_DENSE_BOUNDS_RTOL)
+        # (a D-G-K iterate's γ is the norm of a G-scaled plant, not a bound of µ)
+        if not checks and not constraints and not mixed and upper[k_peak] <= gamma:
+            mu_bound = gamma  # the scaled loop's norm: a bound at every frequency
+    if not mu_bound <= upper[k_peak] * (1.0 + _SUP_RTOL):
+        mu_bound = min(mu_bound, interval_bound(CL, final, dense, rtol=_SUP_RTOL,
+                                                max_splits=_SUP_SPLITS).bound)
     return MusynResult(
         K=K, CL=CL, mu_peak=float(upper[k_peak]), mu_lower_peak=float(np.max(final.lower)),
-        peak_omega=float(dense[k_peak]), mu=final, history=tuple(history),
+        peak_omega=float(dense[k_peak]), mu_bound=float(mu_bound), mu=final,
+        history=tuple(history),
         best_iteration=best_it, stop_reason=stop_reason, reduced_from=reduced_from,
         seconds=time.perf_counter() - t_start, omega=omega,
-        certificates=_certificates(constraints, CL_full))
+        certificates=_certificates(constraints, CL_full), warnings=checks)
 
 
 class _GivenController(NamedTuple):
@@ -973,6 +1043,23 @@ def _scaled(G, nmeas, ncon, fit, struct, free):
                       errors=tuple(fit.errors) + (0.0,))
         sizes = sizes + [free]
     return scaled_plant(G, nmeas, ncon, fit, sizes)
+
+
+def _floored(d) -> np.ndarray:
+    """Per-block D magnitudes with each block's floored at ``_D_FLOOR`` of its largest."""
+    d = np.array(d, dtype=float)
+    return np.maximum(d, _D_FLOOR * np.max(d, axis=1, keepdims=True))
+
+
+def _gscaled(G, nmeas, ncon, fit, struct, free, mu, d, beta, omega, weights):
+    """The D-G-scaled plant of D-G-K (:mod:`.gfit`): the D-scaled plant with the real
+    blocks' G-scalings of ``mu`` at level ``beta`` (taken with the D magnitudes ``d``
+    that were fitted) fitted and absorbed."""
+    from .gfit import fit_gscales, gscale_data, gscaled_plant
+
+    g = np.clip(gscale_data(mu, struct, beta, d), -_G_CLIP, _G_CLIP)
+    gfit = fit_gscales(omega, g, struct, beta, weights=weights)
+    return gscaled_plant(_scaled(G, nmeas, ncon, fit, struct, free), nmeas, ncon, struct, gfit)
 
 
 def _constrained_k_step(PD, nmeas, ncon, opts, struct, constraints, scales):
