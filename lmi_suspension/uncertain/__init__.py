@@ -7,10 +7,12 @@ systems as LFTs (:func:`uss`, :func:`feedback`, :func:`connect`) -> :func:`lftda
 
 from .atoms import UComplex, UReal, ULTIDyn, ucomplex, ultidyn, ureal
 from .lfr import USS, UBlock, UMat, umat
+from .analysis import RobstabResult, WcgainResult, robstab, wcgain
 from .uss import LFTData, connect, feedback, lftdata, nominal, uss, usample, usubs
 
 __all__ = [
     "UReal", "UComplex", "ULTIDyn", "ureal", "ucomplex", "ultidyn",
     "USS", "UMat", "UBlock", "umat",
+    "RobstabResult", "WcgainResult", "robstab", "wcgain",
     "LFTData", "uss", "feedback", "connect", "lftdata", "usubs", "usample", "nominal",
 ]
