@@ -6,7 +6,7 @@ Data flow: model (:mod:`lmi_suspension.seat`) -> generalized plant
 (:mod:`lmi_suspension.mu`) -> simulation (:mod:`lmi_suspension.seat`) -> report.
 """
 
-from . import errors
+from . import errors, uncertain
 from .errors import LmiSuspensionError
 from .lti import GeneralizedPlant, freqresp, hinfnorm, lft
 from .mu import MusynOptions, MussvOptions, mussv, musyn
@@ -15,5 +15,5 @@ from .synthesis import HinfsynOptions, HinfsynResult, hinfsyn
 __version__ = "0.1.0"
 
 __all__ = ["GeneralizedPlant", "lft", "hinfnorm", "freqresp", "hinfsyn", "HinfsynOptions", "HinfsynResult",
-           "mussv", "MussvOptions", "musyn", "MusynOptions", "LmiSuspensionError", "errors",
+           "mussv", "MussvOptions", "musyn", "MusynOptions", "LmiSuspensionError", "errors", "uncertain",
            "__version__"]

@@ -1,0 +1,235 @@
+"""Uncertain models (ureal/ultidyn, LFT arithmetic, reduction, usubs) and robstab/wcgain.
+
+Reference values and their sources:
+- usubs: the same plants built directly with numbers (tests/uncertain_plants.py), compared
+  by transfer-function values at several s.
+- robstab, x'' + c x' + k x: stable iff c > 0 and k > 0 (second-order Routh-Hurwitz);
+  third order s^3 + a s^2 + b s + c: stable iff a, c > 0 and a b > c, which gives the
+  margin 5 - sqrt(13) in closed form (tests/uncertain_plants.py).
+- ultidyn: small-gain theorem, margin = 1 / (bound ‖G‖∞) for one SISO full block.
+- wcgain: 1/(s^2 + 2 ζ s + 1) peaks at 1/(2 ζ sqrt(1 - ζ^2)) (ζ < 1/sqrt 2), largest at
+  the smallest ζ.
+Brute-force comparisons (grids of the box) are in the slow tests at the end.
+"""
+
+import time
+
+import control
+import numpy as np
+import pytest
+
+from lmi_suspension.errors import AssumptionError, NonFiniteError, ParameterError
+from lmi_suspension.lti import hinfnorm
+from lmi_suspension.uncertain import (USS, connect, feedback, lftdata, nominal, robstab, ucomplex,
+                                      ultidyn, ureal, usample, uss, usubs, wcgain)
+from uncertain_plants import (PLANTS, THIRD_MARGIN, brute_margin, brute_wcgain, lag_loop_direct,
+                              lag_loop_uncertain, physical, third_uncertain, two_mass_direct,
+                              two_mass_uncertain)
+
+S_POINTS = [0.0, 0.3j, 1j, 2.5j, 1 + 2j, 10j]
+W60 = np.logspace(-2, 2, 60)
+
+
+def snippet():
+    k = ureal("k", 1.0, plusminus=0.4)
+    m = ureal("m", 1.0, plusminus=0.3)
+    A = [[0, 1], [-k / m, -0.1 / m]]
+    return uss(A, [[0], [1 / m]], [[1, 0]], [[0]])
+
+
+def tf_close(P, D, rtol=1e-10):
+    for s in S_POINTS:
+        a, b = np.asarray(P(s)), np.asarray(D(s))
+        assert np.allclose(a, b, rtol=rtol, atol=1e-12), (s, a, b)
+
+
+# ---------------------------------------------------------------- models
+def test_snippet_minimal_repetitions_and_usubs():
+    G = snippet()
+    d = lftdata(G)
+    assert d.names == ("k", "m")
+    assert d.blk.to_blk().tolist() == [[-1, 0], [-1, 0]]  # k:1, m:1
+    P = usubs(G, {"k": 1.2, "m": 0.9})
+    assert isinstance(P, control.StateSpace)
+    tf_close(P, control.ss([[0, 1], [-1.2 / 0.9, -0.1 / 0.9]], [[0], [1 / 0.9]], [[1, 0]], [[0]]))
+
+
+def test_reduction_keeps_needed_repetitions():
+    k = ureal("k", 1.0, plusminus=0.2)
+    # diag(k, k) needs k twice (rank 2); a rank-one use needs it once
+    two = uss([[-k, 0], [0, -k]], np.eye(2), np.eye(2), np.zeros((2, 2)))
+    one = uss([[-k, -k], [0, -1]], np.eye(2), np.eye(2), np.zeros((2, 2)))
+    assert lftdata(two).blk.to_blk().tolist() == [[-2, 0]]
+    assert lftdata(one).blk.to_blk().tolist() == [[-1, 0]]
+    tf_close(usubs(one, {"k": 1.1}), control.ss([[-1.1, -1.1], [0, -1]], np.eye(2), np.eye(2), 0))
+    # k - k has no uncertainty left
+    assert lftdata(uss([[-1 + k - k]], [[1]], [[1]], [[0]])).blk is None
+
+
+@pytest.mark.parametrize("name", ["two-mass spring-damper (k, m2)", "mass-spring + lag + PD loop (m, tau)"])
+def test_usubs_equals_direct_model(name):
+    unc, direct, spec = PLANTS[name]
+    G = unc()
+    rng = np.random.default_rng(7)
+    for _ in range(4):
+        vals = {n: physical(spec, n, rng.uniform(-1.5, 1.5)) for n in spec}
+        tf_close(usubs(G, vals), control.ss(*direct(*vals.values())))
+
+
+def test_lftdata_closes_to_usubs():
+    """F_u(M, Δ) at normalised δ, evaluated by hand, equals usubs at the physical value."""
+    G = lag_loop_uncertain()
+    d = lftdata(G)
+    dv = {"m": 0.7, "tau": -0.4}
+    Delta = np.diag(np.concatenate([np.full(b[0] * -1, dv[n]) for b, n in zip(d.blk.to_blk(), d.names)]))
+    vals = {n: d.atoms[i].value(dv[n]) for i, n in enumerate(d.names)}
+    P = usubs(G, vals)
+    for s in S_POINTS[1:]:
+        M = np.asarray(d.M(s)).reshape(d.M.noutputs, d.M.ninputs)
+        M11, M12, M21, M22 = M[:d.nz, :d.nw], M[:d.nz, d.nw:], M[d.nz:, :d.nw], M[d.nz:, d.nw:]
+        Fu = M22 + M21 @ Delta @ np.linalg.solve(np.eye(d.nz) - M11 @ Delta, M12)
+        assert np.allclose(Fu, np.asarray(P(s)).reshape(Fu.shape), rtol=1e-10)
+
+
+def test_connect_equals_feedback():
+    m = ureal("m", 1.0, plusminus=0.3)
+    P = uss([[0, 1], [-1 / m, -0.2 / m]], [[0], [1 / m]], [[1, 0]], [[0]], inputs=["u"], outputs=["y"])
+    S = control.summing_junction(inputs=["r", "-y"], output="e")
+    C = control.ss([], [], [], [[3.0]], inputs="e", outputs="u")
+    T1 = connect([P, S, C], inputs=["r"], outputs=["y"])
+    T2 = feedback(P * 3.0, 1)
+    for v in (0.75, 1.2):
+        tf_close(usubs(T1, {"m": v}), usubs(T2, {"m": v}))
+    direct = control.feedback(control.ss([[0, 1], [-1 / 1.2, -0.2 / 1.2]], [[0], [1 / 1.2]], [[1, 0]], 0) * 3.0, 1)
+    tf_close(usubs(T1, {"m": 1.2}), direct)
+
+
+def test_asymmetric_range_map_and_usubs():
+    m = ureal("m", 1.0, range=(0.5, 3.0))
+    assert [m.value(d) for d in (-1.0, 0.0, 1.0)] == pytest.approx([0.5, 1.0, 3.0], rel=1e-14)
+    d = np.linspace(-1, 1, 11)
+    assert np.all(np.diff(m.value(d)) > 0)  # monotone on the box
+    G = uss([[-1 / m]], [[1]], [[1]], [[0]])
+    tf_close(usubs(G, {"m": 2.2}), control.ss([[-1 / 2.2]], [[1]], [[1]], [[0]]))
+    assert ureal("p", 2.0, percent=(10, 30)).hi == pytest.approx(2.6)
+
+
+def test_ultidyn_and_nominal_and_usample():
+    D = ultidyn("D", (1, 1), bound=0.5)
+    P = control.tf([1], [1, 1])
+    G = uss(P * (1 + D))
+    assert lftdata(G).blk.to_blk().tolist() == [[1, 1]]
+    dval = control.tf([0.4], [1, 2])
+    tf_close(usubs(G, {"D": dval}), P * (1 + dval))
+    tf_close(nominal(G), control.ss(P))
+    s1, v1 = usample(snippet(), 5, np.random.default_rng(3))
+    s2, v2 = usample(snippet(), 5, np.random.default_rng(3))
+    assert v1 == v2 and all(0.6 <= v["k"] <= 1.4 and 0.7 <= v["m"] <= 1.3 for v in v1)
+    tf_close(s1[2], usubs(snippet(), v1[2]))
+
+
+# ---------------------------------------------------------------- errors
+@pytest.mark.parametrize("build, err, text", [
+    (lambda: ureal("kappa", 1.0, range=(1.5, 2.0)), ParameterError, "kappa"),
+    (lambda: ureal("kappa", 1.0, range=(1.0, 1.0)), ParameterError, "zero width"),
+    (lambda: ureal("kappa", 0.0, percent=10), ParameterError, "kappa"),
+    (lambda: ureal("kappa", float("nan"), plusminus=1), NonFiniteError, "kappa"),
+    (lambda: ureal("kappa", 1.0, plusminus=float("inf")), NonFiniteError, "kappa"),
+    (lambda: ureal("kappa", 1.0), ParameterError, "exactly one"),
+    (lambda: ureal("kappa", 1.0, plusminus=0.1) + ureal("kappa", 1.0, plusminus=0.2), ParameterError, "kappa"),
+    (lambda: usubs(snippet(), {"q": 1.0}), ParameterError, "'q'"),
+    (lambda: usubs(snippet(), {"k": float("nan")}), NonFiniteError, "'k'"),
+    (lambda: ucomplex("zeta", 1.0, -0.1), ParameterError, "zeta"),
+])
+def test_bad_input_is_a_typed_error_naming_the_parameter(build, err, text):
+    t0 = time.perf_counter()
+    with pytest.raises(err, match=text):
+        build()
+    assert time.perf_counter() - t0 < 1.0
+    assert issubclass(err, ValueError)
+
+
+def test_robstab_refuses_unstable_nominal():
+    k = ureal("k", -1.0, plusminus=0.1)
+    with pytest.raises(AssumptionError, match="not stable"):
+        robstab(uss([[0, 1], [-k, -1]], [[0], [1]], [[1, 0]], [[0]]))
+
+
+# ---------------------------------------------------------------- robstab / wcgain (closed forms)
+def test_robstab_snippet_real_pole_at_zero():
+    """k = 1 - 0.4 α reaches 0 at α = 2.5 (a pole at s = 0), before m = 0 at α = 10/3."""
+    r = robstab(snippet(), W60)
+    assert r.lower <= 2.5 * (1 + 1e-9) and r.upper >= 2.5 * (1 - 1e-9)
+    assert r.upper / r.lower - 1 < 0.05
+    assert r.critical_frequency == pytest.approx(0.0, abs=1e-6)
+    assert r.worst["k"] == pytest.approx(0.0, abs=1e-8) and r.checked
+    assert np.max(usubs(snippet(), dict(r.worst)).poles().real) >= -1e-7
+
+
+def test_robstab_third_order_closed_form():
+    G = third_uncertain()
+    r = robstab(G, W60)
+    assert r.lower <= THIRD_MARGIN * (1 + 1e-6) and r.upper >= THIRD_MARGIN * (1 - 1e-6)
+    assert r.upper / r.lower - 1 < 0.05
+    p = usubs(G, dict(r.worst)).poles()
+    k = np.argmax(p.real)
+    assert p[k].real >= -1e-7 and abs(p[k].imag) == pytest.approx(r.critical_frequency, rel=1e-5)
+    # the Routh boundary a b = c at the worst values
+    a, b, c = (r.worst[n] for n in "abc")
+    assert a * b == pytest.approx(c, rel=1e-6)
+
+
+def test_robstab_ultidyn_small_gain():
+    P = control.tf([2.0], [1, 0.5, 4])  # peak gain from hinfnorm
+    D = ultidyn("D", (1, 1), bound=0.25)
+    T = feedback(uss(P), D)
+    gP = hinfnorm(P)[0]
+    r = robstab(T, W60)
+    assert r.lower <= 1 / (0.25 * gP) * 1.001 and r.upper >= 1 / (0.25 * gP) * 0.99
+    assert r.upper / r.lower - 1 < 0.05 and r.checked
+
+
+def test_wcgain_damping_closed_form():
+    z = ureal("zeta", 0.3, plusminus=0.1)
+    G = uss([[0, 1], [-1, -2 * z]], [[0], [1]], [[1, 0]], [[0]])
+    g = wcgain(G, W60)
+    exact = 1 / (2 * 0.2 * np.sqrt(1 - 0.2**2))
+    assert g.lower <= exact * (1 + 1e-6) <= g.upper * (1 + 1e-6) + 1e-12
+    assert g.lower == pytest.approx(exact, rel=1e-6)
+    assert g.upper / g.lower - 1 < 0.05
+    assert hinfnorm(usubs(G, dict(g.worst)))[0] == pytest.approx(g.lower, rel=1e-9)
+    assert g.worst["zeta"] == pytest.approx(0.2)
+
+
+def test_wcgain_unstable_in_box_is_infinite():
+    c = ureal("c", 1.0, plusminus=1.5)
+    g = wcgain(uss([[0, 1], [-1, -c]], [[0], [1]], [[1, 0]], [[0]]), W60)
+    assert g.lower == np.inf and g.upper == np.inf
+
+
+# ---------------------------------------------------------------- brute force (slow)
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(PLANTS))
+def test_robstab_against_brute_force(name):
+    unc, direct, spec = PLANTS[name]
+    G = unc()
+    r = robstab(G)
+    bm = brute_margin(direct, spec, points=41 if len(spec) < 3 else 21)
+    # the grid's margin is an upper bound of the true one, within the grid's resolution
+    assert r.lower <= bm * (1 + 1e-6)
+    assert r.upper <= bm * (1 + 1e-6) and r.upper >= bm * (1 - 0.02)
+    assert r.upper / r.lower - 1 < 0.05
+    assert np.max(usubs(G, dict(r.worst)).poles().real) >= -1e-7
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", list(PLANTS))
+def test_wcgain_against_brute_force(name):
+    unc, direct, spec = PLANTS[name]
+    G = unc()
+    g = wcgain(G)
+    bg = brute_wcgain(direct, spec, points=21 if len(spec) < 3 else 9)
+    assert g.upper >= bg * (1 - 1e-6)         # the grid's worst is attained: below the bound
+    assert g.lower >= bg * (1 - 1e-3)          # our search does at least as well as the grid
+    assert g.upper / g.lower - 1 < 0.05
+    assert hinfnorm(usubs(G, dict(g.worst)))[0] == pytest.approx(g.lower, rel=1e-9)
