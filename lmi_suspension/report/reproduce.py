@@ -742,7 +742,7 @@ def _design_facts(summaries, u_max: float) -> tuple:
     then not the linear one designed).
     """
     nyquist = math.pi / _SAMPLE_TIME
-    fast = [f"{_LONG_NAMES[c.name]} {c.fastest_pole:.4g}" for c in summaries
+    fast = [f"{_LONG_NAMES[c.name]} {_pole_text(c.fastest_pole)}" for c in summaries
             if not c.error and c.fastest_pole > nyquist]
     facts = []
     if fast:
@@ -757,6 +757,11 @@ def _design_facts(summaries, u_max: float) -> tuple:
         facts.append(f"actuator saturated on the bump (largest commanded force above "
                      f"{u_max:.0f} N): {', '.join(saturated)}")
     return tuple(facts)
+
+
+def _pole_text(pole: float) -> str:
+    """A pole magnitude in rad/s as the table prints it (whole numbers below 1e5)."""
+    return format(pole, ".0f" if pole < 1e5 else ".1e")
 
 
 def _fmt(value: float, spec: str) -> str:
@@ -801,7 +806,7 @@ def comparison_table(summary: ReproduceSummary) -> str:
             map(math.isfinite, c.peak_u_command)) else math.nan
         # * marks a pole the 1 kHz realization in controllers/ does not resolve
         star = "*" if c.fastest_pole > math.pi / _SAMPLE_TIME else ""
-        pole = format(c.fastest_pole, ".0f" if c.fastest_pole < 1e5 else ".1e") + star
+        pole = _pole_text(c.fastest_pole) + star
         if c.name == "passive":
             margin, stable, pole = "no loop", "yes", "-"
         else:
