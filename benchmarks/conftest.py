@@ -5,8 +5,18 @@ one (``benchmarks/current.py``) can say what it was measured on."""
 import os
 from importlib import metadata
 
+#: load average when the session started: other jobs on the machine inflate the times
+_LOAD_AT_START: tuple = ()
+
+
+def pytest_sessionstart(session):
+    global _LOAD_AT_START
+    _LOAD_AT_START = os.getloadavg()
+
 
 def pytest_benchmark_update_machine_info(config, machine_info):
+    import numpy  # noqa: F401  (loads OpenBLAS, so that threadpoolctl sees it)
+
     try:
         import threadpoolctl
 
@@ -27,3 +37,6 @@ def pytest_benchmark_update_machine_info(config, machine_info):
             versions[dist] = None
     machine_info["versions"] = versions
     machine_info["cpu_count"] = os.cpu_count()
+    # 1-minute load averages at the start and the end of the run
+    machine_info["load_average"] = [round(_LOAD_AT_START[0], 2) if _LOAD_AT_START else None,
+                                    round(os.getloadavg()[0], 2)]

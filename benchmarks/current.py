@@ -57,6 +57,9 @@ def _machine(run: dict) -> tuple[str, str]:
     cpu = info.get("cpu", {}).get("brand_raw") or info.get("processor") or "unknown CPU"
     cores = info.get("cpu_count") or info.get("cpu", {}).get("count")
     machine = f"{cores}-core {cpu}" if cores else cpu
+    load = info.get("load_average")
+    if load and None not in load:
+        machine += f", load average {load[0]:g} at the start and {load[1]:g} at the end"
     blas = info.get("openblas") or {}
     kernel = blas.get("kernel") or "kernel not recorded"
     if blas.get("OPENBLAS_CORETYPE"):
@@ -65,6 +68,13 @@ def _machine(run: dict) -> tuple[str, str]:
     if threads:
         kernel += f", {threads} thread{'s' if str(threads) != '1' else ''}"
     return machine, kernel
+
+
+def _loaded(run: dict) -> bool:
+    """Other work ran beside the benchmark: a load average above the core count."""
+    info = run.get("machine_info", {})
+    load, cores = info.get("load_average") or [], info.get("cpu_count")
+    return bool(cores) and any(x is not None and x > cores for x in load)
 
 
 def _seconds(bench: dict) -> float:
@@ -142,6 +152,7 @@ def entries_from_run(path: Path) -> list[dict]:
                     f"-p no:cacheprovider --benchmark-json=FILE",
             source=f"benchmarks/results/{path.name}",
             commit=(commit.get("id") or "")[:10] + (" (dirty)" if commit.get("dirty") else ""),
+            loaded=_loaded(run),
             versions={k: v for k, v in versions.items() if v})
         out.append(entry)
     return out
@@ -188,14 +199,26 @@ def quoted_figures(entries: list[dict]) -> dict[str, str]:
     h = e["hinfsyn"]
     has = set(h["columns"])
     for n in (22, 40):
-        f[f"hinfsyn_{n}_lmi"] = _num(_cell(h, n, "LMI [s]"), ".2f")
-        f[f"hinfsyn_{n}_riccati"] = _num(_cell(h, n, "Riccati [s]"), ".2f")
-        f[f"hinfsyn_{n}_dkpy"] = _num(_cell(h, n, "dkpy [s]"), ".2f") \
-            if "dkpy [s]" in has else "not measured in this run"
+        f[f"hinfsyn_{n}_lmi"] = _num(_cell(h, n, "LMI [s]"), ".2f") + " s"
+        f[f"hinfsyn_{n}_riccati"] = _num(_cell(h, n, "Riccati [s]"), ".2f") + " s"
+        if "dkpy [s]" not in has:
+            f[f"hinfsyn_{n}_dkpy"] = "not measured in this run"
+            continue
+        f[f"hinfsyn_{n}_dkpy"] = _num(_cell(h, n, "dkpy [s]"), ".2f") + " s"
+        if "certified γ dkpy" in has and _cell(h, n, "certified γ dkpy") == "no controller":
+            f[f"hinfsyn_{n}_dkpy"] += " to return no controller"
+    # which peers failed where, when the table says (a run's JSON does)
+    for method, column in (("riccati", "certified γ Riccati"), ("dkpy", "certified γ dkpy")):
+        if column in has:
+            j = h["columns"].index(column)
+            unstable = [str(r[0]) for r in h["rows"] if str(r[j]).startswith("inf")]
+            none = [str(r[0]) for r in h["rows"] if r[j] == "no controller"]
+            f[f"hinfsyn_{method}_unstable_at"] = " and ".join(unstable) or "no"
+            f[f"hinfsyn_{method}_none_at"] = ", ".join(none) or "no"
     ratios = [r[h["columns"].index("LMI/Riccati")] for r in h["rows"] if r[0] >= 22]
     ratios = [r for r in ratios if isinstance(r, (int, float))]
     f["hinfsyn_ratio_from_22"] = f"{min(ratios):.1f}–{max(ratios):.1f}"
-    f["hinfsyn_source"] = f"{h['date']}, {h['kernel']}"
+    f["hinfsyn_source"] = f"{h['date']}, {h['machine']}, OpenBLAS {h['kernel']}"
     m = e["musyn"]
     f["musyn_lmi_mu"] = _num(_cell(m, "LMI K-steps (default)", "µ (dense grid)"), ".4f")
     f["musyn_lmi_s"] = _num(_cell(m, "LMI K-steps (default)", "seconds"), ".1f")
@@ -250,6 +273,11 @@ def render(entries: list[dict]) -> str:
         out += ["| " + " | ".join(_fmt(c) for c in row) + " |" for row in e["rows"]]
         if e.get("note"):
             out += ["", e["note"][0].upper() + e["note"][1:] + "."]
+        if e.get("loaded"):
+            out += ["", "The machine was shared during this run (load average above its "
+                        "core count): its times are inflated against an idle run, the peers' "
+                        "as much as ours; the certified figures do not depend on it. The "
+                        "idle figures of earlier runs are in the history."]
         out.append("")
     out.append(MARKER)
     return "\n".join(out) + "\n"
