@@ -231,11 +231,13 @@ def quoted_figures(entries: list[dict]) -> dict[str, str]:
     mus = [r[j] for r in k["rows"] for j in (1, 3)]
     secs = [r[j] for r in k["rows"] for j in (2, 4)]
     f["musyn_kernels_mu"] = f"{min(mus):.4f}–{max(mus):.4f}"
-    f["musyn_kernels_spread"] = f"{max(mus) / min(mus) - 1:.1e}"
+    f["musyn_kernels_spread"] = re.sub(r"e-0(\d)", r"e-\1", f"{max(mus) / min(mus) - 1:.1e}")
     f["musyn_kernels_s"] = f"{min(secs):.0f}–{max(secs):.0f}"
     f["musyn_kernels_count"] = str(len(mus))
     s = e["sweep"]
     f["sweep_1000_wall_2_workers"] = _num(_cell(s, 2, "wall [s]"), ".0f")
+    f["sweep_1000_wall_1_worker"] = _num(_cell(s, 1, "wall [s]"), ".0f")
+    f["sweep_1000_rate_2_workers"] = _num(_cell(s, 2, "cases/s"), ".1f")
     f["sweep_source"] = f"{s['date']}, {s['kernel']}"
     return f
 

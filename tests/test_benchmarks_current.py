@@ -39,6 +39,9 @@ def test_comparison_page_quotes_only_current_figures():
     page = (ROOT / "docs" / "comparison.md").read_text()
     used = set(re.findall(r"\{\{\s*(\w+)\s*\}\}", page))
     assert used and used <= set(figures), used - set(figures)
+    for other in (ROOT / "docs").glob("guide/*.md"):  # other pages quote some too
+        names = set(re.findall(r"\{\{\s*(\w+)\s*\}\}", other.read_text()))
+        assert names <= set(figures), (other.name, names - set(figures))
     # the stale figures this page once carried (issue 40)
     for stale in ("0.964–0.972", "0.9687", "0.9706", "10.8 s", "14.3 s", "7.4 s"):
         assert stale not in page, stale
