@@ -3,8 +3,13 @@ numpydoc, from the docstrings), and the notebooks executed during the build (mys
 reading their percent-format sources through jupytext).
 
 Build: ``sphinx-build -W -b html docs docs/_build/html`` (warnings are errors).
+
+While iterating on the prose, ``LMI_DOCS_NB_EXECUTION=off`` (or ``cache``) skips (or
+caches) the notebooks' execution; the default, and CI, run them all.
 """
 
+import json
+import os
 import shutil
 from pathlib import Path
 
@@ -23,6 +28,9 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
     "sphinx.ext.mathjax",
+    # MathJax 3 shipped inside a PyPI package and copied into _static/: the pages render
+    # their maths with no network at read time (sphinx.ext.mathjax alone loads a CDN)
+    "sphinx-mathjax-offline",
     "numpydoc",
 ]
 
@@ -39,11 +47,18 @@ def _copy_notebooks():
 
 _copy_notebooks()
 nb_custom_formats = {".py": ["jupytext.reads", {"fmt": "py:percent"}]}
-nb_execution_mode = "force"  # every build runs them: the pages show today's numbers
+# every build runs them: the pages show today's numbers
+nb_execution_mode = os.environ.get("LMI_DOCS_NB_EXECUTION", "force")
 nb_execution_timeout = 600
 nb_execution_raise_on_error = True  # a failing notebook fails the build
 nb_merge_streams = True
-myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence"]
+# the notebooks' tables are display(Markdown(...)) pipe tables: CommonMark (the default)
+# has no tables and shows the pipes as a paragraph; MyST renders them as HTML tables
+nb_render_markdown_format = "myst"
+myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "substitution"]
+# the benchmark figures the pages quote ({{ name }}), from the file that also writes
+# BENCHMARKS.md's tables (benchmarks/current.py): the two cannot disagree
+myst_substitutions = json.loads((ROOT / "benchmarks" / "current.json").read_text())["figures"]
 myst_heading_anchors = 3
 
 # .rst first: autosummary writes its generated pages with the first suffix

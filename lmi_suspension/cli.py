@@ -73,6 +73,9 @@ def _cmd_reproduce(args: argparse.Namespace) -> int:
         if bar is not None:
             bar.close()
     sys.stdout.write(comparison_table(summary) + "\n")
+    figures = sum(1 for f in summary.files if f.suffix == ".png")
+    sys.stdout.write(f"{figures} figures, summary.json and controllers/ in {summary.out_dir} "
+                     f"({summary.seconds:.0f} s)\n")
     return 0
 
 

@@ -40,6 +40,8 @@ EXPECTED_PNGS = {
 }
 #: the stand-in of the shipped constrained controller: a weaker low-passed stiffness
 K_CONSTRAINED = control.ss([[-150.0]], [[150.0, 0.0]], [[4000.0]], [[0.0, 500.0]])
+#: the stand-in LMI H∞ controller's fastest pole, rad/s (above the 1 kHz Nyquist rate)
+FAST_POLE = 5000.0
 #: the stand-in of the shipped refined controller: another low-passed stiffness
 K_REFINED = control.ss([[-250.0]], [[250.0, 0.0]], [[6000.0]], [[0.0, 800.0]])
 
@@ -70,8 +72,12 @@ def _stand_in(fail_riccati=False):
     def design_nominal_hinf(design=None, *, params=None, method="lmi"):
         if method == "riccati" and fail_riccati:
             raise AssumptionError("stand-in: D12 rank deficient")
-        gain = 10000.0 if method == "lmi" else 25000.0
-        return control.ss([[-300.0]], [[300.0, 0.0]], [[gain]], [[0.0, 0.0]])
+        if method == "lmi":
+            # plus a fast mode that nothing excites, above the 1 kHz Nyquist rate
+            # (3142 rad/s), as the real nominal designs have: the run reports it as a fact
+            return control.ss([[-300.0, 0.0], [0.0, -FAST_POLE]], [[300.0, 0.0], [0.0, 0.0]],
+                              [[10000.0, 0.0]], [[0.0, 0.0]])
+        return control.ss([[-300.0]], [[300.0, 0.0]], [[25000.0]], [[0.0, 0.0]])
 
     def analyse_uncertainty(K, design=None, *, params=None, omega=None, rng=None):
         calls.append("analysis")
@@ -304,6 +310,41 @@ def test_comparison_table_lists_every_controller(run):
     for long_name in R._LONG_NAMES.values():
         assert long_name in table
     assert f"{run.summary.limit_peak:.3f}" in table
+
+
+@pytest.mark.slow
+def test_design_facts_are_in_the_summary_not_in_warnings(monkeypatch, tmp_path, caplog):
+    """A pole above the 1 kHz Nyquist rate and a saturated actuator are facts about the
+    designs: the summary (summary.json, the table) states them, no warning is logged."""
+    api, *_ = _stand_in()
+    monkeypatch.setattr(R, "_design_api", lambda: api)
+    with caplog.at_level("WARNING"):
+        summary = R.reproduce(tmp_path, rng=np.random.default_rng(0), delays=(0.0,),
+                              quick=True)
+    assert not [r for r in caplog.records if r.levelname == "WARNING"], caplog.text
+    c = summary.controller("hinf_lmi_nominal")
+    assert c.fastest_pole == pytest.approx(FAST_POLE)
+    pole_facts = [f for f in summary.facts if "Nyquist rate 3142 rad/s" in f]
+    assert len(pole_facts) == 1 and "H∞ LMI (no delay) 5000" in pole_facts[0]
+    # the µ stand-in (pole at 200 rad/s) is resolved and not named
+    assert "µ (D-K)" not in pole_facts[0]
+    data = json.loads((tmp_path / "summary.json").read_text())
+    assert data["facts"] == list(summary.facts)
+    entry = data["controllers"]["hinf_lmi_nominal"]
+    assert entry["fastest_pole"] == pytest.approx(FAST_POLE)
+    assert entry["resolved_at_sample_time"] is False
+    assert data["controllers"]["mu"]["resolved_at_sample_time"] is True
+    # saturation: the facts name exactly the designs whose command exceeds 1500 N
+    saturated = {c.name for c in summary.controllers
+                 if c.peak_u_command and max(c.peak_u_command) > 1500.0}
+    sat_fact = [f for f in summary.facts if f.startswith("actuator saturated")]
+    for name in R.CONTROLLER_NAMES:
+        named = bool(sat_fact) and f"{R._LONG_NAMES[name]} " in sat_fact[0]
+        assert named == (name in saturated), name
+    assert data["controllers"]["hinf_lmi_nominal"]["saturates_on_bump"] == [
+        max(c.peak_u_command) > 1500.0]
+    table = R.comparison_table(summary)
+    assert "5000*" in table and "Nyquist rate 3142 rad/s" in table
 
 
 def test_bad_delays_fail_before_any_design(monkeypatch, tmp_path):

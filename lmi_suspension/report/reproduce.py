@@ -17,6 +17,7 @@ import json
 import logging
 import math
 import shutil
+import textwrap
 import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -149,6 +150,10 @@ class ControllerSummary:
     sampled_peak_z3dd : tuple of float
         Peak ``|z̈3|`` of the 1 kHz sampled-data loop on the bump at each delay (the
         controllers shipped with a discrete realization; empty otherwise).
+    fastest_pole : float
+        Largest pole magnitude of the controller, rad/s (0 for the passive seat). Above
+        the Nyquist rate ``π/dt`` of the 1 kHz realization written beside it
+        (3142 rad/s), that realization does not resolve the pole.
     """
 
     name: str
@@ -162,6 +167,7 @@ class ControllerSummary:
     error: str = ""
     peak_u_command: tuple = ()
     sampled_peak_z3dd: tuple = ()
+    fastest_pole: float = 0.0
 
     @property
     def stable_on_interval(self) -> bool:
@@ -192,6 +198,11 @@ class ReproduceSummary:
         Wall time of each stage, s.
     data : mapping
         Everything written to ``summary.json``.
+    facts : tuple of str
+        Facts about the designs that a reader of the table needs (controller poles that
+        the 1 kHz realizations do not resolve, actuator saturation on the bump), one
+        sentence each; also ``summary.json``'s ``facts``. They are properties of the
+        compared designs, not failures of the run, so they are not logged as warnings.
     """
 
     out_dir: Path
@@ -203,6 +214,7 @@ class ReproduceSummary:
     seconds: float
     timings: Mapping[str, float] = field(repr=False)
     data: Mapping = field(repr=False)
+    facts: tuple = ()
 
     def controller(self, name: str) -> ControllerSummary:
         """The summary of the controller called ``name``."""
@@ -342,7 +354,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     """
     from .. import __version__
     from ..io import save_controller, save_controller_mat
-    from ..seat.sampled import discretise_controller, simulate_sampled
+    from ..seat.sampled import discretise_controller, fastest_pole, simulate_sampled
     from ..seat import (
         SeatParameters,
         bump,
@@ -488,7 +500,9 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         K = controllers[name]
         tok = stage(f"simulate_{name}", f"simulating {_LONG_NAMES[name]} at "
                     f"{len(delays)} delays (bump, noise) ...")
-        entry: dict = {"order": 0 if K is None else int(K.nstates)}
+        pole = 0.0 if K is None else fastest_pole(K)
+        entry: dict = {"order": 0 if K is None else int(K.nstates), "fastest_pole": pole,
+                       "resolved_at_sample_time": pole < math.pi / _SAMPLE_TIME}
         for road_name, road in (("bump", road_bump), ("noise", road_noise)):
             runs[road_name][name] = {}
             if K is None:  # passive: the delay changes nothing
@@ -526,8 +540,11 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
             limit_ratio=tuple(bump_value(r, "peak_z3dd") / limit.peak for r in rows),
             peak_u_command=tuple(bump_value(r, "peak_u_command") for r in rows),
             sampled_peak_z3dd=tuple(r["bump_sampled"]["peak_z3dd"] for r in rows
-                                    if "bump_sampled" in r))
+                                    if "bump_sampled" in r),
+            fastest_pole=pole)
         entry["stable_on_interval"] = s.stable_on_interval
+        entry["saturates_on_bump"] = [bool(r["bump"]["peak_u_command"] > params.u_max)
+                                      for r in rows]
         per_ctrl[name] = entry
         summaries.append(s)
 
@@ -566,19 +583,20 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     files.append(save_controller_mat(out / "controller.mat", mu_design.K, inputs=["x1", "x3"],
                                      outputs=["u"], metadata=metadata))
     # every designed controller, with its 1 kHz Tustin realization (the constrained one's
-    # own; a controller with poles above the Nyquist rate is discretised all the same,
-    # and summary.json's fastest poles say so)
+    # own; a controller with poles above the Nyquist rate is discretised all the same:
+    # that is a fact about the design, which the summary's facts and the table report,
+    # not a failure of this run, so the discretisation does not warn)
     (out / "controllers").mkdir(exist_ok=True)
     for name, K in controllers.items():
         if K is None:
             continue
-        Kd = discrete.get(name) or discretise_controller(K, _SAMPLE_TIME)
+        Kd = discrete.get(name) or discretise_controller(K, _SAMPLE_TIME,
+                                                         warn_unresolved=False)
         shipped = {"mu_constrained": constrained, "mu_refined": refined}.get(name)
         meta = dict(metadata) if name == "mu" else (
             dict(shipped[2]) if shipped is not None else
             {"description": f"{_LONG_NAMES[name]}: y = [x1, x3] (m) -> u (N)"})
-        meta["fastest_pole"] = float(np.max(np.abs(np.linalg.eigvals(np.asarray(K.A))))) \
-            if K.nstates else 0.0
+        meta["fastest_pole"] = fastest_pole(K)
         files.append(save_controller(out / "controllers" / f"{name}.json", K,
                                      inputs=["x1", "x3"], outputs=["u"], metadata=meta,
                                      discrete=Kd))
@@ -675,6 +693,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                for h in getattr(getattr(mu_design, "musyn", None), "history", ())]
     total = time.perf_counter() - t_start
     timings["total"] = total
+    facts = _design_facts(summaries, params.u_max)
     data = {
         "version": __version__, "quick": bool(quick), "delays": list(delays),
         "simulation_dt": dt, "units": {"z3dd": "m/s^2", "x1": "m", "u": "N", "delay": "s",
@@ -701,6 +720,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         "mu_refined": None if refined is None else {
             "check": refined[3], "design": refined[2]},
         "timings": timings,
+        "facts": list(facts),
     }
     data = _jsonable(data)
     summary_path = out / "summary.json"
@@ -710,7 +730,38 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     return ReproduceSummary(out_dir=out, files=tuple(files), controllers=tuple(summaries),
                             limit_peak=float(limit.peak), mu_peak=float(mu_design.mu_peak),
                             mu_lower_peak=float(mu_design.mu_lower_peak), seconds=total,
-                            timings=dict(timings), data=data)
+                            timings=dict(timings), data=data, facts=facts)
+
+
+def _design_facts(summaries, u_max: float) -> tuple:
+    """What the table's reader should know about the compared designs, one sentence each.
+
+    Controller poles above the Nyquist rate of the 1 kHz realizations written to
+    ``controllers/`` (those realizations do not resolve them), and the designs whose
+    commanded force exceeds the actuator's ``u_max`` on the bump (the loop simulated is
+    then not the linear one designed).
+    """
+    nyquist = math.pi / _SAMPLE_TIME
+    fast = [f"{_LONG_NAMES[c.name]} {_pole_text(c.fastest_pole)}" for c in summaries
+            if not c.error and c.fastest_pole > nyquist]
+    facts = []
+    if fast:
+        facts.append(f"controller poles above the {1e-3 / _SAMPLE_TIME:g} kHz Nyquist rate "
+                     f"{nyquist:.0f} rad/s: {', '.join(fast)} rad/s (their 1 kHz "
+                     f"realizations in controllers/ do not resolve them)")
+    saturated = [f"{_LONG_NAMES[c.name]} {max(c.peak_u_command):.0f} N" for c in summaries
+                 if not c.error and c.peak_u_command
+                 and all(map(math.isfinite, c.peak_u_command))
+                 and max(c.peak_u_command) > u_max]
+    if saturated:
+        facts.append(f"actuator saturated on the bump (largest commanded force above "
+                     f"{u_max:.0f} N): {', '.join(saturated)}")
+    return tuple(facts)
+
+
+def _pole_text(pole: float) -> str:
+    """A pole magnitude in rad/s as the table prints it (whole numbers below 1e5)."""
+    return format(pole, ".0f" if pole < 1e5 else ".1e")
 
 
 def _fmt(value: float, spec: str) -> str:
@@ -722,21 +773,27 @@ def comparison_table(summary: ReproduceSummary) -> str:
 
     Columns: peak ``|z̈3|`` on the bump at the smallest and largest delay, its ratio to the
     physical limit at the largest delay, the worst peak ``|x1|`` and ``|u|`` over the delays,
-    the largest commanded force, the delay margin and whether the loop is stable over the
-    whole delay range.
+    the largest commanded force, the controller's fastest pole (``*``: above the Nyquist
+    rate of its 1 kHz realization), the delay margin and whether the loop is stable over
+    the whole delay range. Below the table: the physical limit, the µ peak and the facts
+    about the designs (:attr:`ReproduceSummary.facts`).
 
     Examples
     --------
     >>> s = ControllerSummary("mu", (0.0, 0.025), (3.0, 4.0), (0.01, 0.02), (800.0, 900.0),
-    ...                       (True, True), 0.05, (0.5, 0.65))
-    >>> summ = ReproduceSummary(Path("."), (), (s,), 6.17, 0.9, 0.8, 1.0, {}, {})
-    >>> print(comparison_table(summ).splitlines()[2])  # doctest: +NORMALIZE_WHITESPACE
-    µ (D-K)  3.000  4.000  0.65  0.0200  900  n/a  50.0  yes
+    ...                       (True, True), 0.05, (0.5, 0.65), fastest_pole=5000.0)
+    >>> summ = ReproduceSummary(Path("."), (), (s,), 6.17, 0.9, 0.8, 1.0, {}, {},
+    ...                         facts=("a fact",))
+    >>> lines = comparison_table(summ).splitlines()
+    >>> print(lines[2])  # doctest: +NORMALIZE_WHITESPACE
+    µ (D-K)  3.000  4.000  0.65  0.0200  900  n/a  5000*  50.0  yes
+    >>> print(lines[-1])
+    - a fact
     """
     d0, d1 = summary.controllers[0].delays[0], summary.controllers[0].delays[-1]
     head = (f"{'controller':<18} {'z3dd@' + format(d0 * 1e3, 'g') + 'ms':>10} "
             f"{'z3dd@' + format(d1 * 1e3, 'g') + 'ms':>10} {'/limit':>7} {'x1 [m]':>8} "
-            f"{'u [N]':>7} {'u cmd':>7} {'margin[ms]':>10} {'stable':>7}")
+            f"{'u [N]':>7} {'u cmd':>7} {'pole':>8} {'margin[ms]':>10} {'stable':>7}")
     lines = [head, "-" * len(head)]
     for c in summary.controllers:
         name = _LONG_NAMES.get(c.name, c.name)
@@ -747,8 +804,11 @@ def comparison_table(summary: ReproduceSummary) -> str:
         worst_u = max(c.peak_u) if all(map(math.isfinite, c.peak_u)) else math.nan
         worst_cmd = max(c.peak_u_command) if c.peak_u_command and all(
             map(math.isfinite, c.peak_u_command)) else math.nan
+        # * marks a pole the 1 kHz realization in controllers/ does not resolve
+        star = "*" if c.fastest_pole > math.pi / _SAMPLE_TIME else ""
+        pole = _pole_text(c.fastest_pole) + star
         if c.name == "passive":
-            margin, stable = "no loop", "yes"
+            margin, stable, pole = "no loop", "yes", "-"
         else:
             margin = _fmt(c.delay_margin * 1e3, ".1f") if math.isfinite(c.delay_margin) \
                 else ">1000"
@@ -756,8 +816,11 @@ def comparison_table(summary: ReproduceSummary) -> str:
         lines.append(f"{name:<18} {_fmt(c.peak_z3dd[0], '.3f'):>10} "
                      f"{_fmt(c.peak_z3dd[-1], '.3f'):>10} {_fmt(c.limit_ratio[-1], '.2f'):>7} "
                      f"{_fmt(worst_x1, '.4f'):>8} {_fmt(worst_u, '.0f'):>7} "
-                     f"{_fmt(worst_cmd, '.0f'):>7} {margin:>10} "
+                     f"{_fmt(worst_cmd, '.0f'):>7} {pole:>8} {margin:>10} "
                      f"{stable:>7}")
     lines.append(f"physical limit (LP, full road knowledge): {summary.limit_peak:.3f} m/s²; "
                  f"µ peak upper {summary.mu_peak:.4f}, lower {summary.mu_lower_peak:.4f}")
+    # one screen: the facts wrapped to the table's width
+    lines += [textwrap.fill(fact, width=len(head), initial_indent="- ",
+                            subsequent_indent="  ") for fact in summary.facts]
     return "\n".join(lines)

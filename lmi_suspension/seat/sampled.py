@@ -36,7 +36,7 @@ from .roads import RoadInput
 from .simulate import (SimulationResult, _discretise, _params, _plant, _road_on_grid,
                        _scalar, _energy_growing)
 
-__all__ = ["discretise_controller", "simulate_sampled", "DEFAULT_SAMPLE_TIME"]
+__all__ = ["discretise_controller", "fastest_pole", "simulate_sampled", "DEFAULT_SAMPLE_TIME"]
 
 logger = logging.getLogger(__name__)
 
@@ -47,8 +47,32 @@ DEFAULT_SAMPLE_TIME = 1e-3
 _FINE_STEP = 1e-4
 
 
+def fastest_pole(K) -> float:
+    """Largest pole magnitude of a continuous-time controller, rad/s.
+
+    Parameters
+    ----------
+    K : control.StateSpace
+        Continuous-time controller (a static gain has none: 0).
+
+    Returns
+    -------
+    float
+        ``max |eig(K.A)|``; a sampled controller resolves it if it lies below ``π/dt``.
+
+    Examples
+    --------
+    >>> import control
+    >>> fastest_pole(control.ss([[-10.0, 0.0], [0.0, -5000.0]], [[1.0], [1.0]],
+    ...                         [[1.0, 1.0]], [[0.0]]))
+    5000.0
+    """
+    return float(np.max(np.abs(np.linalg.eigvals(np.asarray(K.A))))) if K.nstates else 0.0
+
+
 def discretise_controller(K, dt: float = DEFAULT_SAMPLE_TIME, *, method: str = "tustin",
-                          prewarp: float | None = None) -> control.StateSpace:
+                          prewarp: float | None = None,
+                          warn_unresolved: bool = True) -> control.StateSpace:
     """The controller at sample time ``dt`` (s).
 
     Parameters
@@ -62,6 +86,11 @@ def discretise_controller(K, dt: float = DEFAULT_SAMPLE_TIME, *, method: str = "
         equivalence.
     prewarp : float, optional
         Frequency (rad/s) at which Tustin's map is exact.
+    warn_unresolved : bool
+        Log a warning when a controller pole lies above the Nyquist rate ``π/dt`` (the
+        discrete controller cannot resolve it). A caller that reports the fact itself
+        (:func:`~lmi_suspension.report.reproduce`, with :func:`fastest_pole`) passes
+        ``False``; it is then logged at debug level.
 
     Returns
     -------
@@ -96,10 +125,11 @@ def discretise_controller(K, dt: float = DEFAULT_SAMPLE_TIME, *, method: str = "
                                  f"rad/s, got {prewarp!r}")
         if method != "tustin":
             raise ParameterError("prewarp applies to the Tustin method only")
-    fast = float(np.max(np.abs(np.linalg.eigvals(K.A)))) if K.nstates else 0.0
+    fast = fastest_pole(K)
     if fast > math.pi / dt:
-        logger.warning("controller pole at %.4g rad/s above the Nyquist rate %.4g rad/s: "
-                       "the discrete controller does not resolve it", fast, math.pi / dt)
+        logger.log(logging.WARNING if warn_unresolved else logging.DEBUG,
+                   "controller pole at %.4g rad/s above the Nyquist rate %.4g rad/s: "
+                   "the discrete controller does not resolve it", fast, math.pi / dt)
     kw = {"prewarp_frequency": prewarp} if prewarp is not None else {}
     Kd = control.sample_system(K, dt, method=methods[method], **kw)
     return control.ss(Kd.A, Kd.B, Kd.C, Kd.D, dt, inputs=K.input_labels,

@@ -76,7 +76,7 @@ _RECOVERY_STATIC_REG = 1e-7
 _DIRECT_SOLVE_METHOD = "faer"
 #: threads of that factorisation: one was the fastest on the project's 2-core machines
 #: (γ minimisation of the 22-state benchmark plant: 1.18 s on one thread, 1.25 s on two,
-#: 1.23 s automatic; measured 2026-11-24, BENCHMARKS.md)
+#: 1.23 s automatic; measured 2026-11-24, benchmarks/HISTORY.md)
 _MAX_THREADS = 1
 #: Clarabel's static regularisation in the γ minimisation (its own default is 1e-8).  These
 #: SDPs are nearly degenerate near the optimal γ and the regularisation decides how close
