@@ -83,15 +83,6 @@ _BOUNDS_RTOL = 1e-3
 #: 0.966751 fell below the loop's µ 0.967552 (``method="best"``, SkylakeX kernel, 2
 #: threads; measured 2026-11-26)
 _DENSE_BOUNDS_RTOL = 2e-4
-#: largest |ĝ| fitted in D-G-K.  Where a real block barely matters, the optimal ĝ runs
-#: off to 1e6 (the mass-spring loops of tests/test_dgk.py, away from the µ peak); its
-#: bound's disc |x - jĝ| <= (1 + ĝ²)^(1/2) is then nearly the half-plane it tends to,
-#: which 10 already covers to within 5 % of its radius
-_G_CLIP = 10.0
-#: floor of a block's D magnitude in D-G-K, relative to its largest over the grid: the
-#: mixed bound's optimum drives a real block's D to zero where the parameter cannot
-#: act (with G finite, so ĝ = G/d² runs off), and a log-magnitude fit cannot follow
-_D_FLOOR = 1e-2
 #: slack of the interval certificate of the returned µ over its dense-grid peak
 #: (``MusynResult.mu_bound``): on the distillation loops a fixed scaling certifies a
 #: level 0.6 % above µ 1 % of frequency away from its point, so each 0.1 % of slack
@@ -846,12 +837,9 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
             weights = 0.2 + upper_s / peak_s
 
             def scaled(d):
-                if mixed:  # the D-only scaled peak is no test of a D-G fit
-                    d = _floored(d)
-                    fit = fit_dscales(omega, d, max_order=opts.max_dfit_order,
-                                      rtol=opts.dfit_rtol, weights=weights)
-                    return fit, _gscaled(G.sys, nmeas, ncon, fit, struct, free, mu, d,
-                                         peak_s, omega, weights)
+                if mixed:  # central D-G scalings at the peak level, both fitted
+                    return _dg_scaled(G.sys, nmeas, ncon, struct, free, M_s, peak_s,
+                                      omega, weights, opts)
                 fit = fit_dscales(omega, d, max_order=opts.max_dfit_order,
                                   rtol=opts.dfit_rtol, weights=weights,
                                   mu_check=lambda fits: _scaled_peak(fits, M_s, omega, dk_struct),
@@ -1045,21 +1033,18 @@ def _scaled(G, nmeas, ncon, fit, struct, free):
     return scaled_plant(G, nmeas, ncon, fit, sizes)
 
 
-def _floored(d) -> np.ndarray:
-    """Per-block D magnitudes with each block's floored at ``_D_FLOOR`` of its largest."""
-    d = np.array(d, dtype=float)
-    return np.maximum(d, _D_FLOOR * np.max(d, axis=1, keepdims=True))
+def _dg_scaled(G, nmeas, ncon, struct, free, M, beta, omega, weights, opts):
+    """D-G-K's next plant (:mod:`.gfit`): the central D-G scalings of the loop ``M`` at
+    level ``beta``, D and G fitted, the D-scaled plant with G absorbed."""
+    from .dfit import fit_dscales
+    from .gfit import central_dg, fit_gscales, gscaled_plant
 
-
-def _gscaled(G, nmeas, ncon, fit, struct, free, mu, d, beta, omega, weights):
-    """The D-G-scaled plant of D-G-K (:mod:`.gfit`): the D-scaled plant with the real
-    blocks' G-scalings of ``mu`` at level ``beta`` (taken with the D magnitudes ``d``
-    that were fitted) fitted and absorbed."""
-    from .gfit import fit_gscales, gscale_data, gscaled_plant
-
-    g = np.clip(gscale_data(mu, struct, beta, d), -_G_CLIP, _G_CLIP)
+    d, g, _ = central_dg(M, struct, beta)
+    fit = fit_dscales(omega, d, max_order=opts.max_dfit_order, rtol=opts.dfit_rtol,
+                      weights=weights)
     gfit = fit_gscales(omega, g, struct, beta, weights=weights)
-    return gscaled_plant(_scaled(G, nmeas, ncon, fit, struct, free), nmeas, ncon, struct, gfit)
+    return fit, gscaled_plant(_scaled(G, nmeas, ncon, fit, struct, free), nmeas, ncon,
+                              struct, gfit)
 
 
 def _constrained_k_step(PD, nmeas, ncon, opts, struct, constraints, scales):
