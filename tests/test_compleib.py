@@ -1,5 +1,8 @@
 """LMI H∞ synthesis on COMPleib plants (Leibfritz 2005), most of them singular (D21 = 0).
 
+The plants ship with the package (``lmi_suspension/data/compleib_subset.json``, source and
+licence in ``lmi_suspension/data/COMPLEIB.md``): no test here skips for want of data.
+
 Reference values: no published full-order optimum could be verified for this subset, so
 each problem is checked by independent computations inside the test:
 * the certificate: hinfnorm(lft(P, K)) recomputed here, closed-loop poles stable;
@@ -10,17 +13,14 @@ each problem is checked by independent computations inside the test:
   norm on the *original* plant is an upper bound on the optimum).
 """
 
-import json
-from pathlib import Path
-
 import control
 import numpy as np
 import pytest
 
+from lmi_suspension.examples import compleib
 from lmi_suspension.lti import GeneralizedPlant, hinfnorm, lft
 from lmi_suspension.synthesis import HinfsynOptions, hinfsyn
 
-DATA = Path(__file__).parents[2] / "shared" / "data" / "compleib_subset.json"
 RELAX = HinfsynOptions().gamma_relax
 PROBLEMS = ["AC1", "AC2", "AC3", "AC4", "AC6", "HE1", "HE2", "REA1", "REA2", "DIS1",
             "NN1", "NN2"]
@@ -35,11 +35,29 @@ DEFAULT_BUDGET = 0.001
 
 
 def load(name):
-    if not DATA.exists():
-        pytest.skip(f"COMPleib data not found at {DATA}")
-    v = json.loads(DATA.read_text())["problems"][name]
-    return GeneralizedPlant.from_matrices(v["A"], v["B1"], v["B"], v["C1"], v["C"],
-                                          v["D11"], v["D12"], v["D21"])
+    """The COMPleib plant shipped with the package (lmi_suspension/data/COMPLEIB.md)."""
+    return compleib(name)
+
+
+def test_shipped_data_is_the_documented_transcription():
+    # the SHA-256 that COMPLEIB.md records for the copy of the former out-of-tree file:
+    # an edit of the data must update its provenance note too
+    import hashlib
+    from importlib import resources
+
+    from lmi_suspension.errors import ParameterError
+    from lmi_suspension.examples import COMPLEIB_PROBLEMS
+
+    data = resources.files("lmi_suspension").joinpath("data")
+    raw = data.joinpath("compleib_subset.json").read_bytes()
+    note = data.joinpath("COMPLEIB.md").read_text()
+    assert hashlib.sha256(raw).hexdigest() in note
+    assert len(raw) < 2_000_000 and tuple(PROBLEMS) == COMPLEIB_PROBLEMS
+    # AC4's dimensions as COMPleib lists them (n = 4, nw = 2, nu = 1, nz = 2, ny = 2)
+    P = load("AC4")
+    assert (P.nstates, P.nw, P.nu, P.nz, P.ny) == (4, 2, 1, 2, 2)
+    with pytest.raises(ParameterError, match="no COMPleib problem"):
+        load("AC5")
 
 
 @pytest.mark.parametrize("name", [p for p in PROBLEMS if p != "AC1"])
