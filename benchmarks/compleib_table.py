@@ -1,16 +1,16 @@
 """Certified γ of LMI and python-control H∞ synthesis on the COMPleib subset, as a markdown table.
 
-Run: ``python benchmarks/compleib_table.py`` (needs ../shared/data beside the checkout).
+Run: ``python benchmarks/compleib_table.py`` (the plants ship with the package:
+``lmi_suspension/data/compleib_subset.json``, read by ``lmi_suspension.examples.compleib``).
 """
-import json, time, warnings
+import time, warnings
 warnings.simplefilter("ignore")
-from lmi_suspension.lti import GeneralizedPlant
+from lmi_suspension.examples import COMPLEIB_PROBLEMS, compleib
 from lmi_suspension.synthesis import hinfsyn
-d = json.load(open(str(__import__("pathlib").Path(__file__).resolve().parents[2] / "shared" / "data" / "compleib_subset.json")))["problems"]
 print("| problem | n | LMI optimum (lower) | LMI certified γ | gap | seconds | Riccati (python-control) reported / certified |")
 print("|---|---|---|---|---|---|---|")
-for name, p in d.items():
-    P = GeneralizedPlant.from_matrices(A=p["A"], B1=p["B1"], B2=p["B"], C1=p["C1"], C2=p["C"], D11=p["D11"], D12=p["D12"], D21=p["D21"])
+for name in COMPLEIB_PROBLEMS:
+    P = compleib(name)
     t = time.time()
     try:
         r = hinfsyn(P, P.ny, P.nu); dt = time.time() - t

@@ -8,9 +8,9 @@ count, each run writing its figures to one JSON file, then compare::
     python benchmarks/kernel_agreement.py --compare /tmp/agree
 
 The figures: the certified γ of ``hinfsyn`` (LMI route) on the H∞ benchmark plants
-(``bench_hinfsyn.py``, n = 4 … 40) and on the COMPleib subset (where ``../shared/data``
-is beside the checkout), the µ upper and lower bounds of ``mussv`` on the ``bench_mussv.py``
-responses, the seat's µ design, and (with ``--musyn``) default ``musyn`` on the
+(``bench_hinfsyn.py``, n = 4 … 40) and on the COMPleib subset shipped with the package
+(``lmi_suspension.examples.compleib``), the µ upper and lower bounds of ``mussv`` on the
+``bench_mussv.py`` responses, the seat's µ design, and (with ``--musyn``) default ``musyn`` on the
 distillation problem of ``bench_musyn.py``, with ``method="lmi"`` (the default) and
 ``"best"``.  ``--compare`` prints, per figure, its range
 over the runs and the relative spread ``max/min - 1``, and exits non-zero where a spread
@@ -31,7 +31,6 @@ import warnings
 import numpy as np
 
 HERE = pathlib.Path(__file__).resolve().parent
-COMPLEIB = HERE.parents[1] / "shared" / "data" / "compleib_subset.json"
 
 
 def _label() -> str:
@@ -56,7 +55,7 @@ def measure(with_musyn: bool) -> dict[str, float]:
     from bench_hinfsyn import ORDERS, plant
     from bench_mussv import CASES, problem
 
-    from lmi_suspension.lti import GeneralizedPlant
+    from lmi_suspension.examples import COMPLEIB_PROBLEMS, compleib
     from lmi_suspension.mu import mussv
     from lmi_suspension.seat.design import design_mu_controller
     from lmi_suspension.synthesis import hinfsyn
@@ -65,17 +64,13 @@ def measure(with_musyn: bool) -> dict[str, float]:
     for n in ORDERS:
         P = plant(n)
         out[f"hinfsyn n={n} certified γ"] = float(hinfsyn(P, P.ny, P.nu).gamma)
-    if COMPLEIB.exists():
-        problems = json.loads(COMPLEIB.read_text())["problems"]
-        for name, p in problems.items():
-            P = GeneralizedPlant.from_matrices(A=p["A"], B1=p["B1"], B2=p["B"], C1=p["C1"],
-                                               C2=p["C"], D11=p["D11"], D12=p["D12"],
-                                               D21=p["D21"])
-            g = float(hinfsyn(P, P.ny, P.nu).gamma)
-            # AC1's optimum is 0: its controllers certify at roundoff level, which has no
-            # relative agreement to speak of
-            if g > 1e-6:
-                out[f"COMPleib {name} certified γ"] = g
+    for name in COMPLEIB_PROBLEMS:
+        P = compleib(name)
+        g = float(hinfsyn(P, P.ny, P.nu).gamma)
+        # AC1's optimum is 0: its controllers certify at roundoff level, which has no
+        # relative agreement to speak of
+        if g > 1e-6:
+            out[f"COMPleib {name} certified γ"] = g
     for size, blk in CASES.items():
         M, w = problem(size, 61)
         mu = mussv(M, blk, omega=w, rng=np.random.default_rng(0))

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-__all__ = ["ExamplePlant", "skogestad_distillation"]
+__all__ = ["COMPLEIB_PROBLEMS", "ExamplePlant", "compleib", "skogestad_distillation"]
 
 
 @dataclass(frozen=True)
@@ -71,3 +71,51 @@ def skogestad_distillation() -> ExamplePlant:
                    outputs=["ydel[0]", "ydel[1]", "z[0]", "z[1]", "v[0]", "v[1]"])
     return ExamplePlant(P=P, nmeas=2, ncon=2, blk=np.array([[1, 1], [1, 1], [2, 2]]),
                         source="Skogestad & Postlethwaite (2005), Sec. 8.12.4, Table 8.1")
+
+
+#: the COMPleib problems shipped in ``lmi_suspension/data/compleib_subset.json``
+COMPLEIB_PROBLEMS = ("AC1", "AC2", "AC3", "AC4", "AC6", "HE1", "HE2", "REA1", "REA2", "DIS1",
+                     "NN1", "NN2")
+
+
+def compleib(name: str):
+    """A COMPleib plant shipped with the package, as a generalized plant.
+
+    Leibfritz, *COMPleib: COnstraint Matrix-optimization Problem library*, Universität
+    Trier (2004), problems transcribed from ``COMPleib.m`` (source and licence:
+    ``lmi_suspension/data/COMPLEIB.md``).  Partition ``x' = A x + B1 w + B u``,
+    ``z = C1 x + D11 w + D12 u``, ``y = C x + D21 w`` (``D22 = 0``).
+
+    Parameters
+    ----------
+    name : str
+        One of :data:`COMPLEIB_PROBLEMS`.
+
+    Returns
+    -------
+    GeneralizedPlant
+
+    Raises
+    ------
+    ParameterError
+        ``name`` is not one of the shipped problems.
+
+    Examples
+    --------
+    >>> P = compleib("AC4")
+    >>> P.nstates, P.nu, P.ny
+    (4, 1, 2)
+    """
+    import json
+    from importlib import resources
+
+    from .errors import ParameterError
+    from .lti import GeneralizedPlant
+
+    if name not in COMPLEIB_PROBLEMS:
+        raise ParameterError(f"no COMPleib problem {name!r} here; shipped: "
+                             f"{', '.join(COMPLEIB_PROBLEMS)}")
+    text = resources.files("lmi_suspension").joinpath("data/compleib_subset.json").read_text()
+    v = json.loads(text)["problems"][name]
+    return GeneralizedPlant.from_matrices(v["A"], v["B1"], v["B"], v["C1"], v["C"],
+                                          v["D11"], v["D12"], v["D21"])

@@ -50,7 +50,10 @@ def table(rows, header):
 #
 # A seeded random complex 4×4 matrix and four structures (MATLAB `blk` rows: `[r, c]` full
 # block, `[r, 0]` repeated complex scalar, `[-r, 0]` repeated real scalar). The last column
-# checks the lower bound's Δ independently: $\sigma_{\min}(I - M\Delta)$ must be about 0.
+# checks the lower bound's Δ independently: it must lie in the structure (block-diagonal, real
+# where the block is real, a scalar times I where it is repeated), $\bar\sigma(\Delta)$ must be
+# 1/lower, and $\sigma_{\min}(I - M\Delta)$ must be 0 to rounding (asserted below 1e-9: measured
+# 2026-11-27 at most 1.1e-10, on the mixed real/complex structure; 1e-16 elsewhere).
 
 # %%
 rng = np.random.default_rng(0)
@@ -62,11 +65,32 @@ structures = {"one full 4×4 block": [[4, 4]],
               "repeated complex scalar δI₄": [[4, 0]],
               "two 1×1 + one 2×2 full": [[1, 1], [1, 1], [2, 2]],
               "δI₂ complex, real δ, 1×1 full": [[2, 0], [-1, 0], [1, 1]]}
+
+
+def in_structure(Delta, blk):
+    # Δ = diag(Δ_1, ...) with Δ_i full (r×c, MATLAB's blk), δI (complex scalar) or δI with
+    # δ real
+    i = j = 0
+    mask = np.zeros(Delta.shape, dtype=bool)
+    for r_, c_ in blk:
+        r = abs(r_)
+        c = r if c_ == 0 else c_
+        B = Delta[i:i + r, j:j + c]
+        mask[i:i + r, j:j + c] = True
+        if c_ == 0 and not np.allclose(B, B[0, 0] * np.eye(r), rtol=0, atol=1e-12):
+            return False
+        if r_ < 0 and np.abs(B.imag).max() > 1e-12:
+            return False
+        i, j = i + r, j + c
+    return bool(np.all(Delta[~mask] == 0))
+
+
 rows = []
 for name, blk in structures.items():
     r = mussv(M, blk, rng=np.random.default_rng(0))
     Delta = r.delta
     singular = np.linalg.svd(np.eye(4) - M @ Delta, compute_uv=False).min()
+    assert in_structure(Delta, blk) and singular <= 1e-9      # Δ destabilises, in the set
     assert np.isclose(1 / np.linalg.norm(Delta, 2), r.lower, rtol=1e-6)
     assert r.lower <= r.upper * (1 + 1e-6) and r.upper <= sig * (1 + 1e-6)
     rows.append([name, f"{r.lower:.6f}", f"{r.upper:.6f}", r.method, f"{singular:.1e}"])
@@ -145,9 +169,31 @@ table([[h.index, h.stage, f"{h.gamma:.4f}", f"{h.mu_peak:.4f}", f"{h.mu_lower_pe
       ["iter", "stage", "γ (scaled)", "µ peak", "µ lower peak", "ω peak (rad/s)", "D-fit orders",
        "order of K", "s: K / D / fit"])
 
-# references: the book's companion script Sec8_124.m (same grid, 4th-order fits) and the
-# open-source peer dkpy 0.1.9 after its 3 iterations (measured in benchmarks/bench_musyn.py)
+# references: the book's companion script Sec8_124.m (same grid, 4th-order fits), and the
+# open-source peer dkpy after its 3 iterations, run here where installed (its configuration
+# of benchmarks/bench_musyn.py), else its value measured there with dkpy 0.1.9
 book = [1.1798, 1.0275, 1.0207, 1.0130, 1.0069, 1.0023, 0.9998]
+try:
+    import dkpy
+except ImportError:
+    dkpy = None
+DKPY_MEASURED = 1.0362
+dkpy_mu = DKPY_MEASURED
+if dkpy is not None:
+    eg = dkpy.example_skogestad2006_p325()
+    peer = dkpy.DkIterListOrder(
+        controller_synthesis=dkpy.HinfSynSlicot(),
+        structured_singular_value=dkpy.SsvLmiBisection(solver_params=dict(solver="CLARABEL")),
+        d_scale_fit=dkpy.DScaleFitSlicot(), fit_orders=[4, 4, 4])
+    try:
+        dkpy_mu = float(np.max(peer.synthesize(eg["P"], eg["n_y"], eg["n_u"],
+                                               np.logspace(-3, 3, 61), ex.blk)[2]))
+        print(f"dkpy {dkpy.__version__}, 3 iterations: µ peak {dkpy_mu:.4f}")
+    except Exception as exc:  # dkpy's own failure: reported, the stored value plotted
+        print(f"dkpy failed ({type(exc).__name__}: {exc}); its measured {DKPY_MEASURED} is plotted")
+else:
+    print(f"dkpy is not installed: its value measured in benchmarks/bench_musyn.py "
+          f"({DKPY_MEASURED}) is plotted and compared")
 fig, ax = plt.subplots(figsize=(6, 3.4))
 steps = [h for h in dk.history if h.stage == "dk"]
 ax.plot([h.index for h in steps], [h.mu_peak for h in steps], "o-", label="musyn, D-K iterations")
@@ -155,7 +201,7 @@ for h in dk.history:
     if h.stage == "dscale_search":
         ax.plot([h.index], [h.mu_peak], "*", ms=14, label="musyn, D-scale search")
 ax.plot(range(1, len(book) + 1), book, "s--", label="book's script Sec8_124.m")
-ax.axhline(1.0362, color="gray", ls=":", label="dkpy, 3 iterations")
+ax.axhline(dkpy_mu, color="gray", ls=":", label="dkpy, 3 iterations")
 ax.axhline(1.0, color="r", lw=1)
 ax.axhline(0.9740, color="g", ls="-.", label="book's optimal scalings (µ 0.9740)")
 ax.set_ylim(0.96, 1.06)
@@ -167,6 +213,18 @@ plt.show()
 # independent checks: the final closed loop is stable, and µ never beats its lower bound
 assert np.isfinite(hinfnorm(dk.CL)[0])
 assert np.all(dk.mu.lower <= dk.mu.upper * (1 + 1e-6))
+# against the book (Skogestad & Postlethwaite 2005, Table 8.1 / Sec. 8.12.4, script
+# Sec8_124.m). Iteration 1 is the H∞ controller of the unscaled plant (D = I), where the
+# paths cannot yet differ: its µ peak must be the book's 1.1798 up to the book's rounding
+# (5e-5) and the spread of near-γ-optimal controllers, which certify 0.05 % above the
+# optimum here (1.1804 against 1.1798): 1e-3. Later iterations follow other D-fits and
+# over-relaxation and are plotted, not compared. The book's claim, robust performance
+# (µ < 1), is asserted with the controller returned, against the book script's final µ
+# (0.9998) and against dkpy; 0.9805 measured 2026-11-27, 0.9549-0.9809 over the kernels of
+# BENCHMARKS.md with method="best".
+first = [h for h in dk.history if h.index == 1][0]
+assert abs(first.mu_peak - book[0]) <= 1e-3
+assert dk.mu_peak < book[-1] and dk.mu_peak < dkpy_mu
 print(f"dense-grid µ peak: H∞ controller {mu_hinf.peak:.4f} -> D-K controller {dk.mu_peak:.4f}")
 
 # %% [markdown]

@@ -51,6 +51,12 @@ def test_hinf_objective_alone_is_hinfsyns_lmi_optimum(name):
     assert info.objective_lmi >= ref * (1 - (5e-3 if name == "AC2" else 1e-3))
     assert info.objective_lmi <= ref * (1 + 1e-3)
     assert gamma <= info.objective_lmi * (1 + 5e-3)
+    if name == "AC4":
+        # the one regular plant: python-control's Riccati controller, certified here, is
+        # a reference outside the LMI routes (0.55729070, measured 2026-11-27; msyn's LMI
+        # optimum 0.5572963); issue 41 reported hinfsyn's optimum above it on AC4
+        best = hinfnorm(lft(P, control.hinfsyn(P.sys, P.ny, P.nu)[0]))[0]
+        assert ref <= best * (1 + 1e-6) and info.objective_lmi <= best * (1 + 1e-4)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -166,19 +172,97 @@ def test_a_specification_of_ones_own_rides_in_the_synthesis():
 # ------------------------------------------------------------------- h2hinfsyn
 
 
+def _fake_closed_loop(gamma, nu):
+    """A closed loop whose rows 0-1 have ‖·‖∞ = gamma and row 2 ‖·‖₂ = nu, in closed
+    form: c/(s + 1) has H∞ norm |c| (at ω = 0) and H2 norm |c|/√2."""
+    return control.ss([[-1.0]], [[1.0]], [[gamma], [0.0], [nu * np.sqrt(2.0)]],
+                      np.zeros((3, 1)))
+
+
+# the injected Pareto front: the H∞ optimum 2, and under ‖T∞‖∞ <= γ the H2 optimum
+# ν*(γ)² = 1 + 4/(γ - 1.5) (convex, decreasing); the H2-only controller has ‖T∞‖∞ = 12
+GAMMA_OPT, GAMMA_FREE = 2.0, 12.0
+
+
+def _nu_star(gamma):
+    return np.sqrt(1.0 + 4.0 / (gamma - 1.5))
+
+
+def test_h2hinfsyn_weighted_search_finds_the_injected_pareto_minimum(monkeypatch):
+    """Injected: ``msyn`` replaced by a known Pareto front (above), whose H2 results carry
+    no LMI level (``objective_lmi`` nan, as every H2 minimisation of the plant below
+    does).  Reference: the minimiser of γ² + ν*(γ)² in closed form, f'(γ) = 0 solved by
+    brentq: γ* = 2.4526, cost 11.227, against 13 for the H∞-only controller (2, 3) and
+    145.4 for the H2-only one.  The search's bracket ends 0.08 wide (10 golden steps
+    on [2.004, 12]), so the cost is within 1e-3 of the minimum (f'' <= 12 there)."""
+    import scipy.optimize
+
+    import lmi_suspension.synthesis.multiobjective as mo
+
+    def fake_msyn(G, nmeas, ncon, objective, constraints=(), options=None,
+                  lyapunov_scales=None):
+        if isinstance(objective, HinfBound):
+            gamma, nu, level = GAMMA_OPT, _nu_star(GAMMA_OPT), GAMMA_OPT
+        else:
+            bounds = [c.bound for c in constraints if isinstance(c, HinfBound)]
+            gamma = min(bounds) if bounds else GAMMA_FREE
+            if gamma < GAMMA_OPT:
+                raise InfeasibleError("injected: below the H∞ optimum")
+            nu, level = _nu_star(gamma), float("nan")
+        CL = _fake_closed_loop(gamma, nu)
+        return mo.MultiobjectiveResult(
+            K=control.ss([], [], [], [[0.0]]), CL=CL,
+            objective=gamma if isinstance(objective, HinfBound) else nu,
+            objective_lmi=level, certificates=(), poles=np.array([-1.0]), status="injected",
+            seconds=0.0, warnings=(), lyapunov_scales=())
+
+    monkeypatch.setattr(mo, "msyn", fake_msyn)
+    P = random_plant(5, 3, 1, 3, 2, rng=np.random.default_rng(4), d11=False)  # sizes only
+    g_star = scipy.optimize.brentq(lambda g: 2 * g - 4 / (g - 1.5) ** 2, GAMMA_OPT, GAMMA_FREE,
+                                   xtol=1e-14)
+    best = g_star**2 + _nu_star(g_star) ** 2
+    assert best < 0.9 * (GAMMA_OPT**2 + _nu_star(GAMMA_OPT) ** 2)  # the premise: interior
+    K, CL, normz, info = h2hinfsyn(P, P.ny, P.nu, 1, W=(1.0, 1.0))
+    assert normz[0] == pytest.approx(hinfnorm(control.ss(CL.A, CL.B, np.asarray(CL.C)[:2],
+                                                          np.asarray(CL.D)[:2]))[0], rel=1e-9)
+    assert best <= normz[0] ** 2 + normz[1] ** 2 <= best * (1 + 1e-3)
+    assert normz[0] == pytest.approx(g_star, rel=2e-2)
+    # the weights move the point along the front: W = (1, 4) favours the H2 norm
+    g4 = scipy.optimize.brentq(lambda g: 2 * g - 16 / (g - 1.5) ** 2, GAMMA_OPT, GAMMA_FREE)
+    normz4 = h2hinfsyn(P, P.ny, P.nu, 1, W=(1.0, 4.0))[2]
+    assert normz4[0] == pytest.approx(g4, rel=2e-2) and normz4[0] > normz[0] * 1.1
+
+
 def test_h2hinfsyn_matlab_conventions_and_certified_norms():
+    """On a real plant: W = (1, 0) against the H∞ optimum of the H∞ channel alone by two
+    other routes: SLICOT's γ iteration (python-control's hinfsyn: its γ, 9.95624; its
+    controller destabilises this plant, so only the value is used) and hinfsyn's
+    projected LMIs (9.95677, another formulation than msyn's change of variables);
+    msyn's controller certifies 9.96343 (measured 2026-11-27).  W = (1, 1) against the
+    two single-objective controllers, each certified here: the mixed cost γ² + ν² must
+    beat both (measured: 3661.1 against 3686.7 for the H2-only controller, whose
+    ‖T∞‖∞ is 20.72; the H∞-only one has an infinite H2 norm)."""
     P = random_plant(5, 3, 1, 3, 2, rng=np.random.default_rng(4), d11=False)
     K, CL, normz, info = h2hinfsyn(P, P.ny, P.nu, 1, W=(1.0, 0.0))
-    hinf_only = msyn(P, P.ny, P.nu, HinfBound(Channel(outputs=(0, 1))))
-    assert normz[0] == pytest.approx(hinf_only.objective, rel=1e-6)
+    b = P.blocks()
+    P01 = GeneralizedPlant.from_matrices(A=b["A"], B1=b["B1"], B2=b["B2"], C1=b["C1"][:2],
+                                         C2=b["C2"], D11=b["D11"][:2], D12=b["D12"][:2],
+                                         D21=b["D21"], D22=b["D22"])
+    gamma_slicot = float(control.hinfsyn(P01.sys, P01.ny, P01.nu)[2])
+    gamma_proj = hinfsyn(P01, P01.ny, P01.nu).gamma_lower
+    assert gamma_proj == pytest.approx(gamma_slicot, rel=1e-4)  # the two references agree
+    # certified, so not below the optimum (up to solver accuracy), and within 0.2 % of it
+    assert gamma_slicot * (1 - 1e-4) <= normz[0] <= gamma_slicot * (1 + 2e-3)
     K, CL, normz, info = h2hinfsyn(P, P.ny, P.nu, 1, W=(1.0, 1.0))
     # the norms of the two channels, recomputed here
     sys_inf = control.ss(CL.A, CL.B, np.asarray(CL.C)[:2], np.asarray(CL.D)[:2])
     assert normz[0] == pytest.approx(hinfnorm(sys_inf)[0], rel=1e-9)
     assert normz[1] == pytest.approx(h2_norm(*rows(CL, [2])), rel=1e-9)
-    h2_only = h2hinfsyn(P, P.ny, P.nu, 1, W=(0.0, 1.0))[2]
-    # the mixed point lies between the two single-objective ones
-    assert normz[0] <= h2_only[0] * (1 + 1e-3) and normz[1] >= h2_only[1] * (1 - 1e-3)
+    h2 = msyn(P, P.ny, P.nu, H2Bound(Channel(outputs=(2,))))
+    h2_cost = hinfnorm(control.ss(h2.CL.A, h2.CL.B, np.asarray(h2.CL.C)[:2],
+                                  np.asarray(h2.CL.D)[:2]))[0] ** 2 \
+        + h2_norm(*rows(h2.CL, [2])) ** 2
+    assert normz[0] ** 2 + normz[1] ** 2 < h2_cost * (1 - 1e-3)
 
 
 # ------------------------------------------------------------------- bad input

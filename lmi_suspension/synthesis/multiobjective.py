@@ -705,7 +705,9 @@ def h2hinfsyn(P, nmeas: int, ncon: int, nz2: int, W=(1.0, 0.0), *, regions=(),
 def _weighted(G, nmeas, ncon, inf_ch, h2_ch, w_inf, w_2, regions, options):
     """``min w_inf γ² + w_2 ν²`` as a scalar sweep: the Pareto point of that weighting is
     the minimiser over the H∞ bound γ of ``w_inf γ² + w_2 ν*(γ)²``, ``ν*`` the H2 optimum
-    under ``‖T∞‖∞ <= γ`` (convex in γ), found by a bounded golden-section search."""
+    under ``‖T∞‖∞ <= γ`` (convex in γ), found by a bounded golden-section search.  Each
+    point is judged by the certified norms of its controller, so the controller returned
+    has the lowest certified weighted cost of all points tried."""
     hinf = msyn(G, nmeas, ncon, HinfBound(inf_ch), list(regions), options=options)
     lo = hinf.objective_lmi * (1 + 2 * _LEVEL_RELAX)
     free = msyn(G, nmeas, ncon, H2Bound(h2_ch), list(regions), options=options)
@@ -723,7 +725,11 @@ def _weighted(G, nmeas, ncon, inf_ch, h2_ch, w_inf, w_2, regions, options):
             # Lyapunov matrix can leave nothing, or too little for the solver
             logger.info("h2hinfsyn: no point at ‖T∞‖∞ <= %.6g (%s)", gamma, exc)
             return np.inf, None
-        return w_inf * gamma**2 + w_2 * r.objective_lmi**2, r
+        # the certified norms of the controller this point returns: what the caller gets,
+        # and always finite (objective_lmi is nan where every minimisation needed a solver
+        # recovery, and a nan cost left the search at its first point: issue 41)
+        g_cert = float(HinfBound(inf_ch).certify(r.CL))
+        return w_inf * g_cert**2 + w_2 * float(r.objective)**2, r
 
     best = cost(hi)
     for _ in range(_BRACKET_DOUBLINGS):  # the common Lyapunov matrix is conservative

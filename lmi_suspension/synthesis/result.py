@@ -146,7 +146,8 @@ class HinfsynResult:
     gamma_lower : float or None
         LMI optimum: no controller of any order achieves less (up to solver accuracy).
         When the returned controller certifies below it, ``warnings`` says that the γ
-        minimisation was inaccurate, and it is no lower bound (COMPleib AC4).  None at a
+        minimisation was inaccurate, and it is no lower bound (reported on COMPleib AC4 in
+        issue 41; not reproduced on d4a1a73, tested by injection).  None at a
         fixed ``gamma``, for the Riccati route, and where the certified γ is above even
         the most relaxed reconstruction level of it (``warnings`` then gives the value
         the γ minimisation claimed).
