@@ -96,7 +96,7 @@ class GScaleFit:
 def central_dg(M, struct: BlockStructure, beta: float, g_max: float = 5.0):
     """Scalings for D-G-K at a fixed level β: at each frequency, ``x_i > 0`` per block
     (``D = diag(√x_i I)``) and ``g_i`` per real block (``G = diag(g_i I)``) that
-    maximise the margin ``t`` of
+    maximise the margin ``t`` of::
 
         β² X_R - M* X_L M - j(G M - M* G) ⪰ t I,   x_last = 1,   |g_i| ≤ g_max β x_i.
 

@@ -239,7 +239,7 @@ def interval_bound(CL, mu, omega, *, rtol: float = 1e-3,
 
     Examples
     --------
-    A lightly damped mode between two grid points (µ = |M| for one full block):
+    A lightly damped mode between two grid points (µ = ``|M|`` for one full block):
 
     >>> import control, numpy as np
     >>> from lmi_suspension import freqresp, mussv
