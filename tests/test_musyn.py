@@ -357,12 +357,17 @@ def test_kstep_with_the_published_optimal_dscales_reaches_the_book_optimum():
 
     syn = dk._k_step(recording_hinfsyn, PD, ex.nmeas, ex.ncon, MusynOptions(method="best"))
     assert syn.gamma == pytest.approx(float(hinfnorm(lft(PD, syn.K))[0]), rel=1e-9)
-    assert syn.gamma == pytest.approx(LUNDSTROM_GAMMA, rel=1e-3)  # 0.97395 measured
+    # Which SLICOT level certifies depends on roundoff: γ 0.973946-0.974611 under
+    # Nehalem, Sandybridge and Haswell on 1 and 2 threads, but 0.976858 (+0.32 %) under
+    # Sandybridge on 1 thread (measured 2026-11-27, CI's second pass), so the book's
+    # optimum is met to 0.5 %, and never beaten by more than its rounding
+    assert LUNDSTROM_GAMMA * (1 - 1e-3) <= syn.gamma <= LUNDSTROM_GAMMA * (1 + 5e-3)
     mu = mussv(freqresp(lft(ex.P, syn.K), np.logspace(-4, 4, 321)), ex.blk)
     # (the controller has poles near 2e6 rad/s and the loop near 1e-6 rad/s: its
     # double-precision response is off by ~1e-5 relative, measured in the tests above)
     assert np.max(mu.upper) <= syn.gamma * (1 + 1e-4)
-    assert np.max(mu.upper) == pytest.approx(LUNDSTROM_MU, rel=1e-3)  # 0.97396 measured
+    # µ 0.973945 on five of those rows, 0.976847 on the sixth
+    assert LUNDSTROM_MU * (1 - 1e-3) <= np.max(mu.upper) <= LUNDSTROM_MU * (1 + 5e-3)
     assert np.max(mu.lower) >= np.max(mu.upper) * (1 - 1e-6)
     # python-control's Riccati (SLICOT sb10ad) on the series realization of this scaled
     # plant can certify far above the optimum (2.09 measured on 2026-11-23, 1.0958 on
