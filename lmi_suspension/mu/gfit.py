@@ -136,20 +136,21 @@ def central_dg(M, struct: BlockStructure, beta: float, g_max: float = 5.0):
     x = cp.Variable(nb)
     gv = cp.Variable(nb)
     t = cp.Variable()
-    Mp = cp.Parameter((nout, nin), complex=True)
     zs, ws = struct.row_slices(), struct.col_slices()  # M's rows (z) and columns (w)
     EL = [np.zeros((nout, nout)) for _ in range(nb)]
     ER = [np.zeros((nin, nin)) for _ in range(nb)]
     for i, (z, w) in enumerate(zip(zs, ws)):
         EL[i][z, z] = np.eye(z.stop - z.start)
         ER[i][w, w] = np.eye(w.stop - w.start)
-    XL = sum(x[i] * EL[i] for i in range(nb))
     XR = sum(x[i] * ER[i] for i in range(nb))
     real = [i for i, b in enumerate(struct.blocks) if b.is_real]
-    # G (n_in x n_out) on the real blocks: g_i on their (w_i, z_i) diagonal
-    Gm = sum((gv[i] * _selector(ws[i], zs[i], nin, nout) for i in real),
-             np.zeros((nin, nout)))
-    H = beta**2 * XR - Mp.H @ XL @ Mp - 1j * (Gm @ Mp - Mp.H @ Gm.T) - t * np.eye(nin)
+    # M* X_L M = Σ x_i M* E_i M and j(G M - M* G*) = Σ g_i j(S_i M - M* S_iᵀ): with
+    # these products as the parameters the problem is DPP, compiled once for all ω
+    Q = [cp.Parameter((nin, nin), complex=True) for _ in range(nb)]
+    S = {i: _selector(ws[i], zs[i], nin, nout) for i in real}
+    R = {i: cp.Parameter((nin, nin), complex=True) for i in real}
+    H = (beta**2 * XR - sum(x[i] * Q[i] for i in range(nb))
+         - sum((gv[i] * R[i] for i in real), np.zeros((nin, nin))) - t * np.eye(nin))
     cons = [(H + H.H) / 2 >> 0, x[nb - 1] == 1, x >= 1e-9, t <= 1.0]
     cons += [cp.abs(gv[i]) <= g_max * beta * x[i] for i in real]
     cons += [gv[i] == 0 for i in range(nb) if i not in real]
@@ -158,7 +159,11 @@ def central_dg(M, struct: BlockStructure, beta: float, g_max: float = 5.0):
     g = np.empty((len(real), nf))
     margin = np.empty(nf)
     for k in range(nf):
-        Mp.value = M[:, :, k]
+        Mk = M[:, :, k]
+        for i in range(nb):
+            Q[i].value = Mk.conj().T @ EL[i] @ Mk
+        for i in real:
+            R[i].value = 1j * (S[i] @ Mk - Mk.conj().T @ S[i].T)
         prob.solve(solver=cp.CLARABEL)
         if prob.status not in ("optimal", "optimal_inaccurate") or x.value is None:
             raise SolverError(f"central D-G scalings: solver status {prob.status} at "
