@@ -268,6 +268,13 @@ def _wait_for(predicate, seconds=60.0):
     raise TimeoutError("the dask processes did not come up")
 
 
+def _scheduler_address(path):
+    try:
+        return json.loads(path.read_text())["address"]
+    except (FileNotFoundError, json.JSONDecodeError, KeyError):
+        return None
+
+
 @pytest.fixture
 def dask_processes(tmp_path):
     """A ``dask scheduler`` and two ``dask worker`` processes (no nanny: a killed worker
@@ -277,8 +284,10 @@ def dask_processes(tmp_path):
     procs = [_start(dask + ["scheduler", "--host", "127.0.0.1", "--port", "0",
                             "--no-dashboard", "--scheduler-file", str(sched_file)])]
     try:
-        _wait_for(sched_file.exists)
-        address = json.loads(sched_file.read_text())["address"]
+        # dask writes the file in place, not atomically: it exists empty for a moment
+        # (CI read '' once), so wait until it parses.
+        _wait_for(lambda: _scheduler_address(sched_file) is not None)
+        address = _scheduler_address(sched_file)
         for _ in range(2):
             procs.append(_start(dask + ["worker", address, "--nthreads", "1", "--no-nanny",
                                         "--no-dashboard", "--host", "127.0.0.1"]))
