@@ -11,12 +11,14 @@ import control
 import numpy as np
 import pytest
 
-from lmi_suspension import hinfsyn, lft
+from lmi_suspension import hinfnorm, hinfsyn, lft
+from lmi_suspension.errors import ParameterError
 from lmi_suspension.lti.norms import freqresp
 from lmi_suspension.mu import BlockStructure, MusynOptions, mussv, musyn
 from lmi_suspension.mu.dfit import fit_dscales, scaled_plant
 from lmi_suspension.mu.dk import _mu_part
-from lmi_suspension.mu.gfit import central_dg, fit_gscales, gscaled_plant
+from lmi_suspension.mu.gfit import central_dg, fit_gscales, gscaled_plant, optimal_gscales
+from lmi_suspension.uncertain import ureal, uss, usubs
 
 BLK = [[-1, 0], [2, 2]]
 
@@ -84,24 +86,51 @@ def test_gscaled_plant_is_the_lft_of_the_scaled_bound(loop):
         np.testing.assert_allclose(got[:, :, k], want, rtol=1e-7, atol=1e-9)
 
 
-def test_t_over_h_is_purely_imaginary_and_h_magnitude_matches(loop):
-    """T(jω)/H(jω) = j z(ω) with z the fitted odd function, and |H| = (1 + z²)^(-1/2)
-    within the magnitude fit's error (module docstring of gfit)."""
+@pytest.mark.parametrize("poles", [None, [0.3, 2.0 + 1.5j, 8.0]],
+                         ids=["log-spaced", "with a complex pair"])
+def test_t_over_h_is_purely_imaginary_and_h_magnitude_is_exact(loop, poles):
+    """T(jω)/H(jω) = j z(ω) with z the fitted odd function, and |H|² (1 + z²) = 1 to
+    roundoff: H is the inverse of the spectral factor of 1 + z², not a magnitude fit
+    (module docstring of gfit), for real basis poles and a complex pair alike."""
     _, _, struct, w, _ = loop
     g = np.array([0.8 * w / (0.3 + w**2) - 0.2 * w / (4.0 + w**2)])
-    fit = fit_gscales(w, g, struct, 1.0)
-    x = 1j * w
+    fit = fit_gscales(w, g, struct, 1.0, poles=poles)
+    x = 1j * np.logspace(-3, 3, 301)  # beyond the grid too
     ratio = np.array([complex(fit.T[0](s) / fit.H[0](s)) for s in x])
-    z = fit.z(0, w)
+    z = fit.z(0, x.imag)
     np.testing.assert_allclose(ratio.real, 0.0, atol=1e-9)
     np.testing.assert_allclose(ratio.imag, z, rtol=1e-7, atol=1e-10)
     Hm = np.abs([complex(fit.H[0](s)) for s in x])
-    np.testing.assert_allclose(Hm, 1 / np.sqrt(1 + z**2), rtol=0.05)
+    np.testing.assert_allclose(Hm**2 * (1 + z**2), 1.0, rtol=1e-8)
     assert all(np.all(np.real(sys.poles()) < 0) for sys in (fit.T[0], fit.H[0]))
+    assert fit.HT[0].nstates == 3 * sum(1 if np.imag(c) == 0 else 2 for c in fit.poles[0])
+
+
+def test_optimal_gscales_reach_the_pointwise_mixed_bound_and_certify_on_the_grid(loop):
+    """optimal_gscales restricts G to a rational family (and D to its fit), so its level
+    is at least the pointwise mixed-µ upper bound (mussv's LMI, the optimum over all D
+    and G).  How close it comes depends on the loop: on this Riccati controller's loop
+    and 25-point grid, 6.7 % above with 10 poles (16 poles: 0.9 %; adding the loop's
+    resonant poles to the basis did not help), on the LMI central controller's loop and
+    D-G-K's iterates of the oscillator within 0.5 % (2026-11-27): the test allows 10 %.
+    By construction the controller's D-G-scaled loop has σ̄ <= 1 at every grid
+    frequency, checked here on the plant built from the scalings."""
+    P, K, struct, w, M = loop
+    mu = float(np.max(mussv(M, struct, omega=w, method="lmi").upper))
+    d, _, _ = central_dg(M, struct, mu)
+    dfit = fit_dscales(w, d, max_order=4)
+    PD = scaled_plant(P, 1, 1, dfit, [(1, 1), (2, 2)])
+    Mt = freqresp(_mu_part(lft(PD, K), struct), w)
+    gfit = optimal_gscales(w, Mt, struct, target=mu)
+    assert mu * (1 - 1e-6) <= gfit.beta <= mu * 1.10
+    PDG = gscaled_plant(PD, 1, 1, struct, gfit)
+    on_grid = freqresp(_mu_part(lft(PDG, K), struct), w)
+    sig = [np.linalg.norm(on_grid[:, :, k], 2) for k in range(w.size)]
+    assert max(sig) <= 1 + 1e-5
 
 
 def test_musyn_with_real_blocks_kept_real_returns_certified_bounds():
-    """complexify=False (D-G-K, experimental): whatever its path, the returned controller
+    """complexify=False (D-G-K, the default): whatever its path, the returned controller
     stabilises the loop, its µ bounds use the real structure (lower <= upper on the
     dense grid, both from mussv on the returned loop), and it is the best iterate."""
     P = oscillator()
@@ -115,3 +144,40 @@ def test_musyn_with_real_blocks_kept_real_returns_certified_bounds():
     assert res.best_iteration == int(np.argmin(peaks)) + 1
     again = mussv(freqresp(res.CL, [res.peak_omega]), BLK)
     assert float(np.ravel(again.upper)[0]) == pytest.approx(res.mu_peak, rel=1e-3)
+
+
+def uncertain_oscillator(zeta=0.02, rk=0.5, wp=2.0, wu=1.0, ap=0.05):
+    """The oscillator of :func:`oscillator` written with a ``ureal`` stiffness: inputs
+    [d, n, u], outputs [e, z_u, y]."""
+    k = ureal("k", 1.0, plusminus=rk)
+    A = [[0, 1, 0], [-k, -2 * zeta, 0], [ap, 0, -ap]]
+    B = [[0, 0, 0], [1, 0, 1], [0, 0, 0]]
+    C = [[0, 0, wp], [0, 0, 0], [1, 0, 0]]
+    D = [[0, 0, 0], [0, 0, wu], [0, 0.05, 0]]
+    return uss(A, B, C, D)
+
+
+def test_musyn_takes_an_uncertain_plant_and_its_bound_holds_on_the_scaled_range():
+    """musyn(uss, nmeas, ncon): the structure is lftdata's plus the performance block,
+    and the returned all-frequency bound β = mu_bound means (main loop theorem) that for
+    every stiffness in the range shrunk by 1/β the loop is stable with ‖e/d‖∞ ≤ β:
+    checked by brute force on 21 stiffness values, each loop built by usubs and its
+    norm computed directly (a route that shares nothing with the µ bounds)."""
+    Pu = uncertain_oscillator()
+    res = musyn(Pu, 1, 1, omega=np.logspace(-2, 1.5, 25),
+                options=MusynOptions(max_iter=2, method="riccati", complexify=False,
+                                     n_dense=30))
+    assert res.mu.blk.to_blk().tolist() == [[-1, 0], [2, 2]]
+    beta = res.mu_bound
+    assert res.mu_peak <= beta and np.isfinite(beta)
+    for delta in np.linspace(-1, 1, 21) / beta:
+        loop = lft(usubs(Pu, {"k": 1.0 + 0.5 * delta}), res.K, 1, 1)
+        assert np.all(loop.poles().real < 0)
+        assert float(hinfnorm(loop)[0]) <= beta * (1 + 1e-6)
+
+
+def test_musyn_blk_goes_with_certain_plants_only():
+    with pytest.raises(ParameterError, match="carries its block structure"):
+        musyn(uncertain_oscillator(), 1, 1, BLK)
+    with pytest.raises(ParameterError, match="blk is required"):
+        musyn(oscillator(), 1, 1)

@@ -12,10 +12,10 @@ After the loop, a direct search on the D-scale fit parameters with the K-step in
 (:mod:`.dsearch`), started from the first iterate's D-step, goes on to a local minimum of
 the bound where D-K stalls. The best iterate (lowest µ peak) is returned, never a worse
 last one; the peak of the returned µ upper bound is refined with the LMI bound
-(:func:`_final_bounds`).  Real scalar blocks are treated as complex in the loop unless
-``MusynOptions.complexify`` is False: then each D-step computes the mixed-µ D and G
-scalings, and G is fitted and absorbed into the scaled plant (D-G-K, :mod:`.gfit`,
-experimental).  The returned µ bounds use the true mixed structure either way.
+(:func:`_final_bounds`).  Real scalar blocks stay real: each D-step computes mixed-µ D
+and G scalings, and both are made rational and absorbed into the scaled plant (D-G-K,
+:mod:`.gfit`); ``MusynOptions(complexify=True)`` covers them by complex discs instead.
+The returned µ bounds use the true mixed structure either way.
 """
 
 from __future__ import annotations
@@ -216,15 +216,22 @@ class MusynOptions:
         bound).
     complexify : bool
         Treat real scalar blocks (``[-r, 0]``) as complex in the loop (complex D-K, the
-        conservative cover of a real parameter by a disc; the default while D-G-K is
-        experimental).  With ``False`` they stay real: each D-step computes the
-        mixed-µ scalings D and G, and the G of each real block is fitted and absorbed
-        into the scaled plant with D's fit (D-G-K, Young 1996; :mod:`.gfit`).  Either way the returned bounds use the true structure.  In D-G-K
-        an iterate's ``gamma`` is the H∞ norm of its D-G-scaled plant at the level of
-        the previous µ peak (below 1 certifies that level; it is not itself a bound of
-        µ), the D-steps are plain (``dscale_overrelax`` is not used) and there is no
-        D-scale search; the per-frequency µ bounds with real blocks are LMIs, so each
-        D-step costs more than a complex one.
+        conservative cover of a real parameter by a disc), for comparison.  By default
+        (``False``) they stay real: each D-step takes the central D-scalings of the
+        mixed-µ bound at the peak level, fits them, and then chooses rational G-scalings
+        of the real blocks for the bound itself (one SDP over the grid with the fitted D
+        applied, :func:`~lmi_suspension.mu.gfit.optimal_gscales`), realized exactly and
+        absorbed into the scaled plant (D-G-K, Young 1996; :mod:`.gfit`).  Either way
+        the returned bounds use the true structure.  In D-G-K an iterate's ``gamma`` is
+        the H∞ norm of its D-G-scaled plant, normalised by the level of those scalings
+        (below 1 certifies that level; it is not itself a bound of µ), the D-steps are
+        plain (``dscale_overrelax`` is not used) and there is no D-scale search; the
+        per-frequency µ bounds with real blocks are LMIs, and each real block adds
+        states to the scaled plant (three per basis pole, 9 to 30), so each iteration
+        costs more than a complex one.  Measured on the oscillator of
+        ``tests/test_dgk.py`` (±50 % real stiffness, 40-point grid, no D-scale search;
+        2026-11-27): complex D-K ends at mixed µ 1.1326, D-G-K reaches 1.0412 by
+        iteration 4 (see ``docs/guide/dk.md`` for the current figures).
     """
 
     max_iter: int = 8
@@ -241,7 +248,7 @@ class MusynOptions:
     stop_on_kstep_regression: bool = True
     dscale_overrelax: float = 2.0
     dscale_search: int = 200
-    complexify: bool = True
+    complexify: bool = False
 
     def __post_init__(self):
         if int(self.max_iter) < 1 or int(self.patience) < 1:
@@ -597,7 +604,7 @@ def _dense_grid(omega: np.ndarray, n: int, peak: float, CL) -> np.ndarray:
     return np.unique(np.concatenate(parts))
 
 
-def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | None = None,
+def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptions | None = None,
           callback: Callable[[MusynIteration], None] | None = None,
           rng: np.random.Generator | None = None, constraints=(),
           lyapunov_scales=None, K0=None) -> MusynResult:
@@ -605,15 +612,20 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
 
     Parameters
     ----------
-    P : control.StateSpace or GeneralizedPlant
+    P : control.StateSpace, GeneralizedPlant or lmi_suspension.uncertain.USS
         Generalized plant with inputs ``[w; u]`` and outputs ``[z; y]``; ``w`` and ``z``
         hold the uncertainty channels followed by the performance channels, in the order
-        of ``blk``.
+        of ``blk``.  An uncertain plant (``uss``, inputs ``[d; u]``, outputs
+        ``[e; y]``) carries its uncertainty: ``blk`` is then its :func:`lftdata`
+        structure followed by the full performance block ``[n_d, n_e]``, as MATLAB's
+        ``musyn(P, nmeas, ncon)`` (robust H∞ performance: µ < 1 means
+        ``‖e/d‖∞ < 1`` for every parameter value in its range).
     nmeas, ncon : int
         Number of measurements (last outputs) and controls (last inputs).
     blk : array_like or BlockStructure
         MATLAB-style block structure; the last block is usually the fictitious full
-        performance block. ``F_l(P, K)`` must be ``(Σ c_i) × (Σ r_i)``.
+        performance block. ``F_l(P, K)`` must be ``(Σ c_i) × (Σ r_i)``.  Required for
+        a certain plant, not given for an uncertain one.
     omega : array_like, optional
         Design frequency grid, rad/s (default :func:`default_omega`).
     options : MusynOptions, optional
@@ -677,6 +689,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     t_start = time.perf_counter()
     opts = options if options is not None else MusynOptions()
     rng = rng if rng is not None else np.random.default_rng(0)
+    P, blk = _with_uncertainty(P, blk, nmeas, ncon)
     G = GeneralizedPlant.from_statespace(P, nmeas, ncon)
     struct = BlockStructure.coerce(blk)
     constraints = tuple(constraints)
@@ -839,7 +852,7 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
             def scaled(d):
                 if mixed:  # central D-G scalings at the peak level, both fitted
                     return _dg_scaled(G.sys, nmeas, ncon, struct, free, M_s, peak_s,
-                                      omega, weights, opts)
+                                      omega, weights, opts, K_ref)
                 fit = fit_dscales(omega, d, max_order=opts.max_dfit_order,
                                   rtol=opts.dfit_rtol, weights=weights,
                                   mu_check=lambda fits: _scaled_peak(fits, M_s, omega, dk_struct),
@@ -931,7 +944,8 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
     k_peak = int(np.argmax(upper))
     checks: tuple = ()
     mu_bound = float("inf")
-    if reduced_from is None:
+    # (a D-G-K iterate's γ is the norm of a G-scaled plant, not a bound of µ)
+    if reduced_from is None and not (mixed and best_it > 1):
         # the dense grid reaches below the design grid, where a certificate computed on
         # the scaled plant can fail: the returned loop's µ is the witness.  Its record
         # was reported already, so the finding goes to the result, not into the record.
@@ -940,7 +954,6 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
                               f"iteration {best_it} on the dense grid (at "
                               f"{float(dense[int(np.argmax(final.lower))]):.3g} rad/s)",
                               rtol=_DENSE_BOUNDS_RTOL)
-        # (a D-G-K iterate's γ is the norm of a G-scaled plant, not a bound of µ)
         if not checks and not constraints and not mixed and upper[k_peak] <= gamma:
             mu_bound = gamma  # the scaled loop's norm: a bound at every frequency
     if not mu_bound <= upper[k_peak] * (1.0 + _SUP_RTOL):
@@ -953,6 +966,31 @@ def musyn(P, nmeas: int, ncon: int, blk, *, omega=None, options: MusynOptions | 
         best_iteration=best_it, stop_reason=stop_reason, reduced_from=reduced_from,
         seconds=time.perf_counter() - t_start, omega=omega,
         certificates=_certificates(constraints, CL_full), warnings=checks)
+
+
+def _with_uncertainty(P, blk, nmeas: int, ncon: int):
+    """``(P, blk)`` of a certain plant as given; of an uncertain one, its ``lftdata``
+    with the full performance block appended."""
+    from ..uncertain.lfr import _Uncertain
+    from ..uncertain.uss import lftdata
+
+    if not isinstance(P, _Uncertain):
+        if blk is None:
+            raise ParameterError("blk is required for a certain plant (only an uncertain "
+                                 "one carries its block structure)")
+        return P, blk
+    if blk is not None:
+        raise ParameterError("an uncertain plant carries its block structure: do not "
+                             "give blk with it")
+    data = lftdata(P)
+    nd = data.M.ninputs - data.nw - int(ncon)
+    ne = data.M.noutputs - data.nz - int(nmeas)
+    if nd < 1 or ne < 1:
+        raise DimensionError(f"the uncertain plant has {nd} performance inputs and {ne} "
+                             f"performance outputs besides ncon={ncon} and nmeas={nmeas}; "
+                             "musyn needs at least one of each")
+    rows = ([] if data.blk is None else data.blk.to_blk().tolist()) + [[nd, ne]]
+    return data.M, rows
 
 
 class _GivenController(NamedTuple):
@@ -1033,18 +1071,21 @@ def _scaled(G, nmeas, ncon, fit, struct, free):
     return scaled_plant(G, nmeas, ncon, fit, sizes)
 
 
-def _dg_scaled(G, nmeas, ncon, struct, free, M, beta, omega, weights, opts):
-    """D-G-K's next plant (:mod:`.gfit`): the central D-G scalings of the loop ``M`` at
-    level ``beta``, D and G fitted, the D-scaled plant with G absorbed."""
+def _dg_scaled(G, nmeas, ncon, struct, free, M, beta, omega, weights, opts, K_ref):
+    """D-G-K's next plant (:mod:`.gfit`): the central D-scalings of the loop ``M`` at
+    level ``beta``, fitted; then the G-scalings that minimise the level of ``K_ref``'s
+    D-scaled loop on the grid (:func:`~.gfit.optimal_gscales`), absorbed."""
     from .dfit import fit_dscales
-    from .gfit import central_dg, fit_gscales, gscaled_plant
+    from .gfit import central_dg, gscaled_plant, optimal_gscales
 
-    d, g, _ = central_dg(M, struct, beta)
+    d, _, _ = central_dg(M, struct, beta)
     fit = fit_dscales(omega, d, max_order=opts.max_dfit_order, rtol=opts.dfit_rtol,
                       weights=weights)
-    gfit = fit_gscales(omega, g, struct, beta, weights=weights)
-    return fit, gscaled_plant(_scaled(G, nmeas, ncon, fit, struct, free), nmeas, ncon,
-                              struct, gfit)
+    PD = _scaled(G, nmeas, ncon, fit, struct, free)
+    Mt = freqresp(_mu_part(lft(PD, K_ref, nmeas, ncon), struct), omega)
+    gfit = optimal_gscales(omega, Mt, struct, target=beta)
+    logger.info("musyn: D-G scalings at level %.5g for the loop at %.5g", gfit.beta, beta)
+    return fit, gscaled_plant(PD, nmeas, ncon, struct, gfit)
 
 
 def _constrained_k_step(PD, nmeas, ncon, opts, struct, constraints, scales):
