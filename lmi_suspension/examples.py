@@ -11,7 +11,8 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-__all__ = ["COMPLEIB_PROBLEMS", "ExamplePlant", "compleib", "skogestad_distillation"]
+__all__ = ["COMPLEIB_PROBLEMS", "ExamplePlant", "compleib", "skogestad_distillation",
+           "stiffness_oscillator", "uncertain_stiffness_oscillator"]
 
 
 @dataclass(frozen=True)
@@ -71,6 +72,56 @@ def skogestad_distillation() -> ExamplePlant:
                    outputs=["ydel[0]", "ydel[1]", "z[0]", "z[1]", "v[0]", "v[1]"])
     return ExamplePlant(P=P, nmeas=2, ncon=2, blk=np.array([[1, 1], [1, 1], [2, 2]]),
                         source="Skogestad & Postlethwaite (2005), Sec. 8.12.4, Table 8.1")
+
+
+def stiffness_oscillator(zeta: float = 0.02, rk: float = 0.5, wp: float = 2.0,
+                         wu: float = 1.0, ap: float = 0.05) -> ExamplePlant:
+    """A lightly damped oscillator with a real uncertain stiffness: a mixed-µ problem.
+
+    ``x'' + 2ζ x' + k x = d + u`` with ``k = 1 + rk δ``, ``δ ∈ [-1, 1]`` real; the
+    performance output is the position through the low-pass ``wp a/(s + a)`` and the
+    control through ``wu``; the measurement is the position with 5 % noise.  A problem
+    of this project (tests/test_dgk.py): its central H∞ controller has mixed µ 1.157
+    and complex µ 2.32 (``mussv``, 2026-11-27), so the disc cover of ``k`` is far from
+    the real interval.
+
+    Inputs ``[w_k, d, n, u]``, outputs ``[z_k, e, z_u, y]``; structure
+    ``[[-1, 0], [2, 2]]``.  :func:`uncertain_stiffness_oscillator` writes the same
+    plant with a ``ureal``.
+
+    Examples
+    --------
+    >>> ex = stiffness_oscillator()
+    >>> ex.P.nstates, ex.blk.tolist()
+    (3, [[-1, 0], [2, 2]])
+    """
+    A = np.array([[0, 1, 0], [-1.0, -2 * zeta, 0], [ap, 0, -ap]])
+    B = np.array([[0, 0, 0, 0], [-rk, 1, 0, 1], [0, 0, 0, 0]])
+    C = np.array([[1, 0, 0], [0, 0, wp], [0, 0, 0], [1, 0, 0]])
+    D = np.array([[0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, wu], [0, 0, 0.05, 0]])
+    return ExamplePlant(P=control.ss(A, B, C, D), nmeas=1, ncon=1,
+                        blk=np.array([[-1, 0], [2, 2]]), source="this project (tests/test_dgk.py)")
+
+
+def uncertain_stiffness_oscillator(zeta: float = 0.02, rk: float = 0.5, wp: float = 2.0,
+                                   wu: float = 1.0, ap: float = 0.05):
+    """:func:`stiffness_oscillator` written with ``k = ureal("k", 1, plusminus=rk)``: an
+    uncertain plant with inputs ``[d, n, u]`` and outputs ``[e, z_u, y]``.
+
+    Examples
+    --------
+    >>> from lmi_suspension.uncertain import lftdata
+    >>> lftdata(uncertain_stiffness_oscillator()).blk.to_blk().tolist()
+    [[-1, 0]]
+    """
+    from .uncertain import ureal, uss
+
+    k = ureal("k", 1.0, plusminus=rk)
+    A = [[0, 1, 0], [-k, -2 * zeta, 0], [ap, 0, -ap]]
+    B = [[0, 0, 0], [1, 0, 1], [0, 0, 0]]
+    C = [[0, 0, wp], [0, 0, 0], [1, 0, 0]]
+    D = [[0, 0, 0], [0, 0, wu], [0, 0.05, 0]]
+    return uss(A, B, C, D)
 
 
 #: the COMPleib problems shipped in ``lmi_suspension/data/compleib_subset.json``

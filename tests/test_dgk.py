@@ -13,23 +13,20 @@ import pytest
 
 from lmi_suspension import hinfnorm, hinfsyn, lft
 from lmi_suspension.errors import ParameterError
+from lmi_suspension.examples import stiffness_oscillator, uncertain_stiffness_oscillator
 from lmi_suspension.lti.norms import freqresp
 from lmi_suspension.mu import BlockStructure, MusynOptions, mussv, musyn
 from lmi_suspension.mu.dfit import fit_dscales, scaled_plant
 from lmi_suspension.mu.dk import _mu_part
 from lmi_suspension.mu.gfit import central_dg, fit_gscales, gscaled_plant, optimal_gscales
-from lmi_suspension.uncertain import ureal, uss, usubs
+from lmi_suspension.uncertain import lftdata, usubs
 
 BLK = [[-1, 0], [2, 2]]
 
 
-def oscillator(zeta=0.02, rk=0.5, wp=2.0, wu=1.0, ap=0.05):
+def oscillator(**kw):
     """Inputs [w_k, d, n, u], outputs [z_k, e, z_u, y]; k = 1 + rk δ."""
-    A = np.array([[0, 1, 0], [-1.0, -2 * zeta, 0], [ap, 0, -ap]])
-    B = np.array([[0, 0, 0, 0], [-rk, 1, 0, 1], [0, 0, 0, 0]])
-    C = np.array([[1, 0, 0], [0, 0, wp], [0, 0, 0], [1, 0, 0]])
-    D = np.array([[0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, wu], [0, 0, 0.05, 0]])
-    return control.ss(A, B, C, D)
+    return stiffness_oscillator(**kw).P
 
 
 @pytest.fixture(scope="module")
@@ -146,15 +143,7 @@ def test_musyn_with_real_blocks_kept_real_returns_certified_bounds():
     assert float(np.ravel(again.upper)[0]) == pytest.approx(res.mu_peak, rel=1e-3)
 
 
-def uncertain_oscillator(zeta=0.02, rk=0.5, wp=2.0, wu=1.0, ap=0.05):
-    """The oscillator of :func:`oscillator` written with a ``ureal`` stiffness: inputs
-    [d, n, u], outputs [e, z_u, y]."""
-    k = ureal("k", 1.0, plusminus=rk)
-    A = [[0, 1, 0], [-k, -2 * zeta, 0], [ap, 0, -ap]]
-    B = [[0, 0, 0], [1, 0, 1], [0, 0, 0]]
-    C = [[0, 0, wp], [0, 0, 0], [1, 0, 0]]
-    D = [[0, 0, 0], [0, 0, wu], [0, 0.05, 0]]
-    return uss(A, B, C, D)
+uncertain_oscillator = uncertain_stiffness_oscillator
 
 
 def test_musyn_takes_an_uncertain_plant_and_its_bound_holds_on_the_scaled_range():
@@ -181,3 +170,21 @@ def test_musyn_blk_goes_with_certain_plants_only():
         musyn(uncertain_oscillator(), 1, 1, BLK)
     with pytest.raises(ParameterError, match="blk is required"):
         musyn(oscillator(), 1, 1)
+
+
+def test_the_ureal_model_is_the_hand_built_lft():
+    """uncertain_stiffness_oscillator (ureal, uss) against stiffness_oscillator (the LFT
+    written by hand): equal at every stiffness in the range (usubs against F_u of the
+    hand-built plant with the same δ), the normalisation of the two LFTs aside."""
+    Pu, ex = uncertain_stiffness_oscillator(), stiffness_oscillator()
+    assert lftdata(Pu).blk.to_blk().tolist() == [[-1, 0]]
+    w = np.logspace(-2, 2, 9)
+    for delta in (-1.0, -0.3, 0.0, 0.7, 1.0):
+        direct = usubs(Pu, {"k": 1.0 + 0.5 * delta})
+        # F_u(P, δ): the δ channel moved last, closed as a lower LFT
+        order = [1, 2, 3, 0]
+        A, B, C, D = (np.asarray(m) for m in (ex.P.A, ex.P.B, ex.P.C, ex.P.D))
+        Pp = control.ss(A, B[:, order], C[order], D[np.ix_(order, order)])
+        Fu = lft(Pp, control.ss([], [], [], [[delta]]), 1, 1)
+        np.testing.assert_allclose(freqresp(direct, w), freqresp(Fu, w), rtol=1e-9,
+                                   atol=1e-12)
