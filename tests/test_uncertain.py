@@ -20,6 +20,7 @@ import pytest
 
 from lmi_suspension.errors import AssumptionError, NonFiniteError, ParameterError
 from lmi_suspension.lti import hinfnorm
+from lmi_suspension.lti.norms import freqresp
 from lmi_suspension.uncertain import (USS, connect, feedback, lftdata, nominal, robstab, ucomplex,
                                       ultidyn, ureal, usample, uss, usubs, wcgain)
 from uncertain_plants import (PLANTS, THIRD_MARGIN, brute_margin, brute_wcgain, lag_loop_direct,
@@ -233,3 +234,20 @@ def test_wcgain_against_brute_force(name):
     assert g.lower >= bg * (1 - 1e-3)          # our search does at least as well as the grid
     assert g.upper / g.lower - 1 < 0.05
     assert hinfnorm(usubs(G, dict(g.worst)))[0] == pytest.approx(g.lower, rel=1e-9)
+
+
+def test_reduction_keeps_a_parameter_beside_large_certain_dynamics():
+    """The structured reduction decides each block's rank relative to that block's own
+    rows: a parameter entering with O(1) coefficients beside a certain part with entries
+    of 1e12 (as a D-G-K controller's states) stays in the model, and usubs still equals
+    the model built with numbers (with a tolerance relative to the whole realization,
+    the parameter was dropped from such a closed loop, 2026-11-27)."""
+    a = ureal("a", -2.0, plusminus=0.5)
+    fast = control.ss([[-1e12]], [[1e12]], [[1e12]], [[0.0]])
+    G = uss([[a]], [[1.0]], [[1.0]], [[0.0]]) + fast
+    assert lftdata(G).names == ("a",)
+    w = np.logspace(-1, 1, 7)
+    for value in (-2.5, -1.7):
+        direct = control.ss([[value]], [[1.0]], [[1.0]], [[0.0]]) + fast
+        np.testing.assert_allclose(freqresp(usubs(G, {"a": value}), w), freqresp(direct, w),
+                                   rtol=1e-9)

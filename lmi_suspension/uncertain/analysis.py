@@ -591,16 +591,31 @@ def wcgain(usys, omega=None, *, rng: np.random.Generator | None = None) -> Wcgai
         cands = [np.zeros(nb)] + _directions(nb, rng, face_pts=5, n_random=100)
         scores = [(_peak_gain(clo, list(d), w), tuple(d)) for d in cands]
         scores.sort(key=lambda s: -s[0])
+        unstable = [np.array(scores[0][1])] if np.isinf(scores[0][0]) else []
 
         def obj(v):
-            return -_peak_gain(clo, list(np.clip(v, -1, 1)), w)
+            v = np.clip(v, -1, 1)
+            g = _peak_gain(clo, list(v), w)
+            if np.isinf(g):  # unstable (or ill posed) inside the box: the answer is inf
+                unstable.append(v)
+                return -1e300  # (Nelder-Mead cannot order -inf values)
+            return -g
 
         best_val, best_v = scores[0][0], np.array(scores[0][1])
         for val, d in scores[:3]:
+            if unstable:
+                break
             sol = scipy.optimize.minimize(obj, np.array(d), method="Nelder-Mead",
                                           options={"maxfev": 80, "xatol": 1e-5, "fatol": 1e-9})
             if -sol.fun > best_val:
                 best_val, best_v = -sol.fun, np.clip(sol.x, -1, 1)
+        if unstable:
+            # robstab's grid did not see it (its margin is certified on the grid only)
+            logger.warning("wcgain: unstable inside the box (robstab's margin %.4g was "
+                           "certified on its grid only)", rs.lower)
+            worst = _values(x.blocks, list(unstable[0]))
+            return WcgainResult(np.inf, np.inf, rs.critical_frequency, MappingProxyType(worst),
+                                rs, time.perf_counter() - t0)
         best_d = list(best_v)
     worst = _values(x.blocks, best_d) if clo is not None else {}
     if clo is not None:

@@ -45,6 +45,9 @@ __all__ = ["UBlock", "UMat", "USS", "as_uncertain", "interconnect_parts", "reduc
 
 logger = logging.getLogger(__name__)
 
+#: relative rank tolerance of the structured Kalman reduction (see _reach)
+_REDUCE_RTOL = 1e-10
+
 
 @dataclass(frozen=True)
 class UBlock:
@@ -494,9 +497,17 @@ def _orth(X, tol):
     return U[:, : int(np.sum(s > tol))]
 
 
-def _reach(And, Bnd, zsizes, wsizes, reducible, tol):
-    """Bases of the smallest structured subspace ⊇ range(Bnd), invariant under And·Δ."""
+def _reach(And, Bnd, zsizes, wsizes, reducible, rtol):
+    """Bases of the smallest structured subspace ⊇ range(Bnd), invariant under And·Δ.
+
+    The rank decision of each block is relative to the size of that block's own rows of
+    ``[Bnd, And]`` (what its reachable vectors are made of), not to the whole
+    realization's: a closed loop with a 22-state D-G-K controller (entries up to ~1e8)
+    had its only real parameter, whose rows are O(1), removed as unreachable with a
+    tolerance relative to the whole (2026-11-27, notebooks/06)."""
     zsl, wsl = _slices(zsizes), _slices(wsizes)
+    tols = [rtol * max(1.0, np.linalg.norm(np.hstack([Bnd[zsl[k]], And[zsl[k]]])))
+            for k in range(len(zsizes))]
     bases = [np.zeros((zsizes[k], 0)) if reducible[k] else None for k in range(len(zsizes))]
     for _ in range(sum(zsizes) + 2):
         Tw = scipy.linalg.block_diag(*[np.eye(wsizes[k]) if bases[k] is None else bases[k]
@@ -507,7 +518,7 @@ def _reach(And, Bnd, zsizes, wsizes, reducible, tol):
         for k in range(len(zsizes)):
             if not reducible[k]:
                 continue
-            Q = _orth(vecs[zsl[k]], tol)
+            Q = _orth(vecs[zsl[k]], tols[k])
             if Q.shape[1] > bases[k].shape[1]:
                 bases[k] = Q
                 changed = True
@@ -553,8 +564,7 @@ def reduce_lfr(x: _Uncertain) -> _Uncertain:
     zsizes = [n] + [b.nz for b in x.blocks]
     wsizes = [n] + [b.nw for b in x.blocks]
     red = [False] + [b.reducible for b in x.blocks]
-    scale = max(1.0, np.linalg.norm(np.block([[And, Bnd], [Cnd, Dyu]])))
-    tol = 1e-10 * scale
+    tol = _REDUCE_RTOL
     # keep full bases as identities: no needless rotation
     def tidy(bases, sizes):
         return [None if (b is not None and b.shape[1] == sizes[k]) else b for k, b in enumerate(bases)]
