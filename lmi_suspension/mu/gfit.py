@@ -54,10 +54,10 @@ logger = logging.getLogger(__name__)
 
 __all__ = ["GScaleFit", "central_dg", "fit_gscales", "gscaled_plant", "optimal_gscales"]
 
-#: poles of the odd basis of ĝ's fit: this many, log-spaced over the design grid.  Not
-#: yet chosen by a measurement: on the lightly damped oscillator of tests/test_dgk.py
-#: they fitted ĝ only to 76-106 % of its peak (2026-11-27), which is why D-G-K is
-#: still experimental
+#: poles of the odd basis of fit_gscales' least-squares fit of a pointwise ĝ (kept for
+#: comparison and as a tool; D-G-K uses optimal_gscales).  On the oscillator of
+#: tests/test_dgk.py 3 log-spaced poles fitted ĝ only to 58-106 % of its peak and D-G-K
+#: ended above complex D-K with them (2026-11-27)
 _G_POLES = 3
 #: basis sizes :func:`optimal_gscales` tries in turn, and how close to the pointwise
 #: mixed-µ peak its level must come.  On the oscillator of tests/test_dgk.py, at the loop
@@ -253,9 +253,9 @@ def _odd_fit(omega: np.ndarray, g: np.ndarray, weights: np.ndarray, c: np.ndarra
 
 
 def _sections(c: np.ndarray, coef: np.ndarray):
-    """``Y(s) = -Σ (a_k/2)/(s + c_k)`` over the poles and their conjugates (real
-    realization, ``z(ω) = Im Y(jω)``... doubled: ``Z(s) = Y(s) - Y(-s)``) and the
-    all-pass ``Π (c_k - s)/(c_k + s)`` with the same poles, both as lists of sections."""
+    """``Y(s) = -Σ (a_k/2)/(s + c_k)`` over the poles and their conjugates, so that
+    ``Z(s) = Y(s) - Y(-s)`` has ``Z(jω) = 2j Im Y(jω) = j z(ω)``, and the all-pass
+    ``Π (c_k - s)/(c_k + s)`` with the same poles: both as lists of real sections."""
     Y, Al = [], []
     for ck, ak in zip(c, _complex_coefficients(c, coef)):
         if ck.imag == 0:
