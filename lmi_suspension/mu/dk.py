@@ -230,8 +230,8 @@ class MusynOptions:
         states to the scaled plant (three per basis pole, 9 to 30), so each iteration
         costs more than a complex one.  Measured on the oscillator of
         ``tests/test_dgk.py`` (±50 % real stiffness, 40-point grid, no D-scale search;
-        2026-11-27): complex D-K ends at mixed µ 1.1326, D-G-K reaches 1.0412 by
-        iteration 4 (see ``docs/guide/dk.md`` for the current figures).
+        2026-11-27): complex D-K ends at mixed µ 1.1326, D-G-K at 1.0069 (iteration 5;
+        ``benchmarks/bench_dgk.py``, figures in ``docs/guide/dk.md``).
     """
 
     max_iter: int = 8

@@ -474,14 +474,12 @@ def _optimal_gscales(omega, Mt, struct, poles, g_max) -> GScaleFit:
     beta0 = float(np.sqrt(max(np.max([np.linalg.norm(Mt[:, :, k], 2) for k in range(nf)]) ** 2,
                               1e-300)))
     cons = []
+    S = [_selector(rl, cl, nin, nout) for _, rl, cl in real]
     for k in range(nf):
         Mk = Mt[:, :, k]
         LMI = lam * np.eye(nin) - Mk.conj().T @ Mk
-        for r, (i, rl, cl) in enumerate(real):
-            S = np.zeros((nin, nout))
-            for p_, q_ in zip(range(rl.start, rl.stop), range(cl.start, cl.stop)):
-                S[p_, q_] = 1.0
-            R = 1j * (S @ Mk - Mk.conj().T @ S.T)
+        for r in range(len(real)):
+            R = 1j * (S[r] @ Mk - Mk.conj().T @ S[r].T)
             LMI = LMI - (a[r] @ Bn[k]) * R
         cons.append((LMI + LMI.H) / 2 >> 0)
     # |ĝ| = |z|/β <= g_max at the grid points, with β <= beta0 (the unscaled level)
