@@ -17,7 +17,7 @@ from lmi_suspension.examples import stiffness_oscillator, uncertain_stiffness_os
 from lmi_suspension.lti.norms import freqresp
 from lmi_suspension.mu import BlockStructure, MusynOptions, mussv, musyn
 from lmi_suspension.mu.dfit import fit_dscales, scaled_plant
-from lmi_suspension.mu.dk import _mu_part
+from lmi_suspension.mu.steps import mu_part as _mu_part
 from lmi_suspension.mu.gfit import central_dg, fit_gscales, gscaled_plant, optimal_gscales
 from lmi_suspension.uncertain import lftdata, usubs
 

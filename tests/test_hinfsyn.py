@@ -649,7 +649,7 @@ def _distillation_with_dscale(a):
     variants of musyn), certified on it: ``(PD, nmeas, ncon, riccati_result)``."""
     from lmi_suspension.examples import skogestad_distillation
     from lmi_suspension.mu.dfit import fit_dscales, scaled_plant
-    from lmi_suspension.mu.dk import _riccati_balanced
+    from lmi_suspension.mu.steps.kstep import _riccati_balanced
 
     ex = skogestad_distillation()
     w = np.logspace(-3, 3, 61)

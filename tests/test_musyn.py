@@ -108,29 +108,31 @@ def test_returned_mu_holds_off_the_design_grid(distillation_design):
     assert res.mu_peak <= res.mu_bound <= res.mu_peak * 1.02
 
 
-def test_kstep_regression_stops_the_loop(monkeypatch):
+def test_kstep_regression_stops_the_loop():
     """An exact K-step never does worse on the scaled plant than the previous controller,
     whose scaled norm (gamma_prev, a separate hinfnorm) is recorded; one that does has
     lost accuracy, and the loop stops there and says why.  Injected: the K-step of
     iteration 2 returns iteration 1's controller, whose certified norm on the new scaled
     plant is gamma_prev itself, reported 10 % above it (plain D-steps, so the rule
-    applies)."""
-    from lmi_suspension.mu import dk
+    applies), through the K-step protocol (``DKSteps``)."""
+    from lmi_suspension.mu.steps import DKSteps
+    from lmi_suspension.mu.steps.kstep import HinfKStep
 
-    real, seen = dk._k_step, []
+    seen = []
 
-    def regressing(hinfsyn, PD, nmeas, ncon, opts, gamma_prev=float("nan")):
-        syn = real(hinfsyn, PD, nmeas, ncon, opts, gamma_prev)
-        seen.append(syn)
-        if len(seen) == 2:
-            return dataclasses.replace(seen[0], gamma=1.1 * gamma_prev)
-        return syn
+    class Regressing(HinfKStep):
+        def __call__(self, PD, *, iteration, gamma_prev):
+            syn = super().__call__(PD, iteration=iteration, gamma_prev=gamma_prev)
+            seen.append(syn)
+            if len(seen) == 2:
+                return dataclasses.replace(seen[0], gamma=1.1 * gamma_prev)
+            return syn
 
-    monkeypatch.setattr(dk, "_k_step", regressing)
     ex = skogestad_distillation()
     res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-3, 3, 31),
                 options=MusynOptions(method="riccati", max_iter=5, patience=5,
-                                     dscale_overrelax=1.0, dscale_search=0))
+                                     dscale_overrelax=1.0, dscale_search=0),
+                steps=DKSteps(kstep=Regressing))
     h = res.history
     assert np.isnan(h[0].gamma_prev) and np.isfinite(h[1].gamma_prev)
     assert len(h) == 2 and h[1].gamma > h[1].gamma_prev
@@ -237,28 +239,30 @@ def test_overrelaxed_dscales_beat_plain_dk():
         assert all(h.gamma >= h.mu_peak * (1 - 1e-3) for h in res.history)
 
 
-def test_overrelaxation_restarts_from_the_best_iterate(monkeypatch):
+def test_overrelaxation_restarts_from_the_best_iterate():
     """When an iterate is not the best, the next D-step starts again from the best
     iterate's scalings; if that restart does not help either, the step after it is a
     plain one from where the loop is (repeating the restart would repeat it exactly).
     Forced here by a K-step that falls back to the first controller from iteration 3 on;
     which controller each scaled plant was built around shows in gamma_prev, that
     controller's norm on it (an independent hinfnorm)."""
-    from lmi_suspension.mu import dk
+    from lmi_suspension.mu.steps import DKSteps
+    from lmi_suspension.mu.steps.kstep import HinfKStep
 
-    real, first = dk._k_step, []
+    first = []
 
-    def stale(*args, **kwargs):
-        syn = real(*args, **kwargs)
-        first.append(syn)
-        return first[0] if len(first) >= 3 else syn
+    class Stale(HinfKStep):
+        def __call__(self, PD, *, iteration, gamma_prev):
+            syn = super().__call__(PD, iteration=iteration, gamma_prev=gamma_prev)
+            first.append(syn)
+            return first[0] if len(first) >= 3 else syn
 
-    monkeypatch.setattr(dk, "_k_step", stale)
     ex = skogestad_distillation()
     res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-3, 3, 61),
                 options=MusynOptions(max_iter=8, patience=3, min_improvement=0.0,
                                      method="riccati", dscale_overrelax=2.0,
-                                     dscale_search=0))
+                                     dscale_search=0),
+                steps=DKSteps(kstep=Stale))
     h = res.history
     assert len(h) == 5 and "no improvement" in res.stop_reason
     assert res.best_iteration == 2 and all(r.mu_peak > h[1].mu_peak for r in h[2:])
@@ -293,7 +297,7 @@ def test_kstep_on_a_balanced_realization_is_certified_on_the_plant(monkeypatch):
     first two variants fail."""
     from lmi_suspension.errors import InfeasibleError
     from lmi_suspension.lti import hinfnorm
-    from lmi_suspension.mu import dk
+    from lmi_suspension.mu.steps import kstep as dk
 
     ex = skogestad_distillation()
     calls = []
@@ -339,7 +343,7 @@ def test_kstep_with_the_published_optimal_dscales_reaches_the_book_optimum():
     scalings (it stops at µ ≈ 1.003, test above), so this pins what is missing on the
     D-step side, not the K-step.
     """
-    from lmi_suspension.mu import dk
+    from lmi_suspension.mu.steps import kstep as dk
     from lmi_suspension.mu.dfit import fit_dscales, scaled_plant
 
     ex = skogestad_distillation()
@@ -409,7 +413,7 @@ def test_best_certified_judges_the_controllers_of_every_realization_on_the_plant
     from types import SimpleNamespace
 
     from lmi_suspension.errors import InfeasibleError
-    from lmi_suspension.mu.dk import _best_certified
+    from lmi_suspension.mu.steps.kstep import _best_certified
     from lmi_suspension.synthesis import HinfsynOptions
 
     PD = control.ss([[-1.0]], [[1.0, 1.0]], [[1.0], [1.0]], np.zeros((2, 2)))
@@ -439,7 +443,7 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     its loop at every frequency (checked on a dense, wider grid) and the number of
     levels stays within the bound."""
     from lmi_suspension.mu.dfit import scaled_plant
-    from lmi_suspension.mu.dk import _SEARCH_LEVELS, _best_certified
+    from lmi_suspension.mu.steps.kstep import _SEARCH_LEVELS, _best_certified
     from lmi_suspension.mu.dsearch import search_dscales
     from lmi_suspension.synthesis import HinfsynOptions
     from lmi_suspension.synthesis.hinfsyn import riccati_level
@@ -598,27 +602,29 @@ def test_initial_controller_is_checked():
         run(unstable[0] * np.eye(2))
 
 
-def test_a_k_step_failing_on_an_over_relaxed_plant_retries_on_the_plain_one(monkeypatch):
+def test_a_k_step_failing_on_an_over_relaxed_plant_retries_on_the_plain_one():
     """Injected: the K-step of iteration 3 (whose plant comes from an over-relaxed
     D-step, iteration 2 being the best) fails once; D-K goes on with the plain D-step's
     plant of the same iteration instead of stopping.  The retry's reference level is
     recomputed here on that plant."""
-    import lmi_suspension.mu.dk as dk
     from lmi_suspension.errors import SolverError
+    from lmi_suspension.mu.steps import DKSteps
+    from lmi_suspension.mu.steps.kstep import HinfKStep
 
     ex = skogestad_distillation()
-    real, plants = dk._k_step, []
+    plants = []
 
-    def k_step(hinfsyn, PD, nmeas, ncon, opts, gamma_prev=float("nan")):
-        plants.append((PD, gamma_prev))
-        if len(plants) == 3:
-            raise SolverError("injected")
-        return real(hinfsyn, PD, nmeas, ncon, opts, gamma_prev)
+    class FailingOnce(HinfKStep):
+        def __call__(self, PD, *, iteration, gamma_prev):
+            plants.append((PD, gamma_prev))
+            if len(plants) == 3:
+                raise SolverError("injected")
+            return super().__call__(PD, iteration=iteration, gamma_prev=gamma_prev)
 
-    monkeypatch.setattr(dk, "_k_step", k_step)
     res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-3, 3, 61),
                 options=MusynOptions(method="riccati", max_iter=3, patience=3,
-                                     dscale_search=0))
+                                     dscale_search=0),
+                steps=DKSteps(kstep=FailingOnce))
     assert res.history[1].mu_peak < res.history[0].mu_peak  # iteration 2 was the best
     assert len(plants) == 4 and len(res.history) == 3
     assert "K-step failed" not in res.stop_reason
@@ -635,7 +641,7 @@ def test_lmi_k_step_knows_the_previous_controllers_level():
     its Riccati-frame hint and as the level above which its γ minimisation has failed
     (gamma_abort, with the K-step's 0.1 % slack); the first K-step has neither, and a
     user's own gamma_abort or fixed γ is kept."""
-    from lmi_suspension.mu.dk import _k_step
+    from lmi_suspension.mu.steps.kstep import _k_step
     from lmi_suspension.synthesis import HinfsynOptions
 
     from lmi_suspension.errors import InfeasibleError
@@ -673,7 +679,7 @@ def test_lmi_k_step_at_the_level_of_a_certified_controller():
     minimisation stops at 2.47 against an optimum of 1.166: the level is recomputed
     here from SLICOT's controller and an independent closed-loop norm, and the K-step's
     controller certifies at or below it (1.16825 against 1.16959, measured)."""
-    from lmi_suspension.mu.dk import _LEVEL_RELAX, _k_step
+    from lmi_suspension.mu.steps.kstep import _LEVEL_RELAX, _k_step
     from lmi_suspension.synthesis import HinfsynOptions
     from lmi_suspension.synthesis.hinfsyn import _hinfsyn
 
@@ -710,7 +716,7 @@ def test_lmi_k_step_without_a_level_falls_back_and_without_a_controller_fails():
     from types import SimpleNamespace
 
     from lmi_suspension.errors import InfeasibleError, SolverError
-    from lmi_suspension.mu.dk import _k_step
+    from lmi_suspension.mu.steps.kstep import _k_step
 
     P = skogestad_distillation().P
     for failing in ("riccati", "fixed"):
@@ -746,11 +752,15 @@ def test_a_plain_rebuild_is_not_repeated_by_a_restart():
     that is not the best continues from itself: restarting from iterate 2 would rebuild
     the very plant iterate 3 was designed on.  The fallback halves the over-relaxation
     (a K-step that failed on one over-relaxed plant failed on the next ones too)."""
-    from lmi_suspension.mu.dk import _DStep, _OverRelaxation
+    from types import SimpleNamespace
+
+    from lmi_suspension.mu.steps import LoopAnalysis
+    from lmi_suspension.mu.steps.fit import _OverRelaxation
 
     relax = _OverRelaxation(2.0)
-    step = lambda k: _DStep(M=None, d_blocks=[np.full(3, float(k))],  # noqa: E731
-                            upper=np.ones(3), mu_peak=1.0, K=None)
+    step = lambda k: LoopAnalysis(  # noqa: E731
+        M=None, mu=SimpleNamespace(d_blocks=[np.full(3, float(k))]), upper=np.ones(3),
+        mu_peak=1.0, peak_omega=1.0, lower_peak=0.0, K=None)
     relax.step(1, 1, step(1))
     relax.fitted([np.ones(3)])
     relax.step(2, 2, step(2))  # the best: an over-relaxed target
@@ -807,7 +817,7 @@ def test_lmi_dk_starts_from_the_central_controller():
     ``sb10ad`` at a fixed level) at 1 % above the γ the LMI certified on the unscaled
     plant; checked here on the distillation problem by recomputing that controller's
     closed-loop norm and poles, and the LMI's level, independently."""
-    from lmi_suspension.mu.dk import _CENTRAL_START_RELAX
+    from lmi_suspension.mu.steps.kstep import _CENTRAL_START_RELAX
 
     ex = skogestad_distillation()
     res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-3, 3, 31),
@@ -831,7 +841,7 @@ def test_central_start_falls_back_to_the_lmi_controller():
     import types
 
     from lmi_suspension.errors import InfeasibleError
-    from lmi_suspension.mu.dk import _central_start
+    from lmi_suspension.mu.steps.kstep import _central_start
     from lmi_suspension.synthesis import HinfsynOptions
 
     P = skogestad_distillation().P

@@ -1,37 +1,38 @@
 """µ-synthesis by D-K iteration (paper eqs. 23–31).
 
-The loop alternates three exchangeable steps and keeps the diagnostics of each:
+:func:`musyn` is a short loop over three exchangeable steps (:mod:`.steps`, each behind
+a small protocol, built from the run's setup):
 
-1. **K-step** — H∞ synthesis on the D-scaled plant ``P_D`` (:func:`hinfsyn`, LMI by default);
-2. **D-step** — the µ upper bound of ``F_l(P, K)`` over a frequency grid and its optimal
-   D-scales (:func:`mussv`);
-3. **D-fit** — stable, minimum-phase rational fits of those D-scales and the next ``P_D``
-   (:func:`fit_dscales`, :func:`scaled_plant`).
+1. **K-step** — H∞ synthesis on the scaled plant ``P_D`` (:mod:`.steps.kstep`: LMI by
+   default, Riccati, or the multi-objective LMI with constraints);
+2. **D/G-step** — µ bounds of ``F_l(P, K)`` over the frequency grid and their optimal
+   scalings (:mod:`.steps.dgstep`, :func:`mussv`);
+3. **fit** — stable, minimum-phase rational fits of those scalings, absorbed into the
+   next ``P_D`` (:mod:`.steps.fit`: D scalings for D-K; D and G scalings, realized
+   exactly, for D-G-K).
 
-After the loop, a direct search on the D-scale fit parameters with the K-step inside
-(:mod:`.dsearch`), started from the first iterate's D-step, goes on to a local minimum of
-the bound where D-K stalls. The best iterate (lowest µ peak) is returned, never a worse
-last one; the peak of the returned µ upper bound is refined with the LMI bound
-(:func:`_final_bounds`).  Real scalar blocks stay real: each D-step computes mixed-µ D
-and G scalings, and both are made rational and absorbed into the scaled plant (D-G-K,
-:mod:`.gfit`); ``MusynOptions(complexify=True)`` covers them by complex discs instead.
-The returned µ bounds use the true mixed structure either way.
+The loop owns what compares iterates: the best one (lowest µ peak meeting every
+constraint), patience, the stopping rules, and the certificates of each iterate (its
+closed-loop poles, µ lower bound against its γ, constraints recomputed).  After it, a
+direct search on the D-scale fit parameters with the K-step inside (:mod:`.dsearch`),
+started from the first iterate's D-step, goes on to a local minimum of the bound where
+D-K stalls.  The best iterate is returned, never a worse last one; its µ is certified on
+a dense grid with the true structure (real blocks real), the grid peak refined with the
+LMI bound (:func:`_final_bounds`) and bounded between grid points (``mu_bound``).
+``MusynOptions(complexify=True)`` covers real blocks by complex discs in the loop.
 """
 
 from __future__ import annotations
 
-import functools
 import logging
 import time
-import warnings
 from dataclasses import dataclass, field, replace
-from typing import Callable, NamedTuple
+from typing import Callable
 
 import control
 import numpy as np
 
-from ..errors import (DimensionError, InfeasibleError, LmiSuspensionError, ParameterError,
-                      SolverError)
+from ..errors import DimensionError, InfeasibleError, LmiSuspensionError, ParameterError
 from ..lti.checks import as_finite_array
 from ..lti.norms import freqresp, hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
@@ -39,41 +40,14 @@ from ..lti.scaling import balanced_statespace
 from .blocks import BlockStructure
 from .dsearch import search_dscales
 from .interval import interval_bound
+from .steps import DKSteps, block_sizes, certificates, mu_part
+from .steps.kstep import (_CHECK_LEVEL, _KSTEP_RTOL, _SEARCH_LEVELS, _best_certified,
+                          _gramian_balanced, _kstep_options)
 
 logger = logging.getLogger(__name__)
 
 __all__ = ["MusynOptions", "MusynIteration", "MusynResult", "musyn", "default_omega"]
 
-#: Suboptimal levels ``(1 + r) γ`` that the Riccati K-step also tries when its γ-optimal
-#: controller certifies above its own γ (the formulas are ill-conditioned at the optimum).
-KSTEP_RICCATI_PROBES = (1e-3, 3e-3, 1e-2, 3e-2, 0.1)
-#: relative slack before a K-step counts as worse than keeping the previous controller
-_KSTEP_RTOL = 1e-3
-#: largest scaled plant on which method="best" falls back to the LMI K-step after Riccati
-_LMI_FALLBACK_MAX_STATES = 30
-#: an over-relaxed D-fit whose scaled loop (previous controller) peaks this much above its
-#: grid value is replaced by the plain one
-_OFFGRID_RTOL = 0.05
-#: level of the central controller that starts D-K with the LMI K-step, relative to the
-#: first K-step's certified γ (:func:`_central_start`).  Distillation problem, 61-point
-#: grid, default options otherwise (measured 2026-11-26, OpenBLAS Haswell / SkylakeX, one
-#: thread): from the central controller at 1 % above, µ 0.9786 / 0.9795 after the D-scale
-#: search (upper = lower bound), where the LMI's own first controller led to 1.035 /
-#: 1.037; the central one at 0 % and 0.8 % above gave 0.9857 and 0.9838 before any search.
-#: The whole default run (Haswell, one thread) at 0.3 / 1 / 2 / 5 % above: µ 0.9820 /
-#: 0.9786 / 0.9774 / 0.9748 in 77 / 33 / 63 / 65 s: any of them beats the LMI's own
-#: start, and 1 % was the fastest
-_CENTRAL_START_RELAX = 0.01
-#: the level of the LMI K-step above the γ certified for SLICOT's controller
-#: (:func:`_level_led_lmi`)
-_LEVEL_RELAX = 3e-3
-#: Clarabel recoveries and reconstruction levels of that K-step's controller LMI: it
-#: succeeded at its second attempt on 5 of 7 plants of a distillation run, and on the
-#: other two further recoveries cost 9 s each and ended "infeasible" all the same.  Its
-#: feasibility problem gets none: on 14 such plants it solved the same 11 without a
-#: recovery, and where it failed (3 plants) it did so in 1.2-1.3 s instead of 4.4-4.8 s
-#: with one (measured 2026-11-26)
-_LEVEL_LED_RECOVERIES = 1
 #: slack of the check µ lower bound <= certified γ of an iterate (the µ bounds are
 #: computed to about 1e-4 on the grid, and γ to 1e-9 by hinfnorm)
 _BOUNDS_RTOL = 1e-3
@@ -427,20 +401,6 @@ def _complexified(struct: BlockStructure) -> BlockStructure:
     return BlockStructure.from_blk(rows)
 
 
-def _block_sizes(struct: BlockStructure) -> list[tuple[int, int]]:
-    return [(b.rows, b.cols) for b in struct.blocks]
-
-
-def _mu_bounds(CL, struct, omega, rng, M=None):
-    """µ bounds of ``CL`` over ``omega``; pass its frequency response ``M`` if known.
-    Returns ``(result, lower_peak)``."""
-    from .bounds import mussv
-
-    M = freqresp(CL, omega) if M is None else M
-    mu = mussv(M, struct, omega=omega, rng=rng)
-    return mu, float(np.max(mu.lower))
-
-
 #: frequencies whose upper bound the final µ refines at a time (see _final_bounds)
 _REFINE_BATCH = 8
 
@@ -485,102 +445,6 @@ def _final_bounds(CL, struct: BlockStructure, omega: np.ndarray, rng):
                    peak_omega=float(omega[k_peak]), **fields)
 
 
-def _scaled_peak(fits, M: np.ndarray, omega: np.ndarray, struct: BlockStructure) -> float:
-    """``max_ω σ̄(D̂_L(jω) M(jω) D̂_R(jω)⁻¹)`` for rational D-scale fits: the bound the next
-    K-step will actually see, so the D-fit order is chosen by it."""
-    s = 1j * omega
-    left = np.empty((M.shape[0], omega.size), dtype=complex)
-    right = np.empty((M.shape[1], omega.size), dtype=complex)
-    row = col = 0
-    for block, fit in zip(struct.blocks, fits):
-        resp = np.asarray(fit(s)).reshape(fit.noutputs, fit.ninputs, omega.size)
-        diag = np.array([resp[k, k] for k in range(fit.noutputs)])  # (1 or r) x nf
-        if diag.shape[0] == 1:
-            left[row:row + block.cols] = diag[0]
-            right[col:col + block.rows] = diag[0]
-        else:
-            left[row:row + block.cols] = diag
-            right[col:col + block.rows] = diag
-        row, col = row + block.cols, col + block.rows
-    scaled = left[:, None, :] * M / right[None, :, :]
-    return float(np.max(np.linalg.norm(np.moveaxis(scaled, -1, 0), ord=2, axis=(1, 2))))
-
-
-def _fit_magnitudes(dfit, omega: np.ndarray) -> list[np.ndarray]:
-    """``|d̂_i(jω)|`` of each block's fit (the first diagonal element of a matrix fit)."""
-    s = 1j * omega
-    return [np.abs(np.asarray(f(s)).reshape(f.noutputs, f.ninputs, omega.size)[0, 0])
-            for f in dfit.fits]
-
-
-def _overrelaxed(d_blocks, previous: list[np.ndarray], alpha: float) -> list[np.ndarray]:
-    """``previous * (d / previous)**alpha`` per block: the D-step's change, extrapolated."""
-    return [np.exp(np.log(p) + alpha * (np.log(np.asarray(d, dtype=float)) - np.log(p)))
-            for d, p in zip(d_blocks, previous)]
-
-
-class _DStep(NamedTuple):
-    """What a D-step starts from: the loop's response, its scalings, its µ, its controller."""
-
-    M: np.ndarray
-    d_blocks: object
-    upper: np.ndarray
-    mu_peak: float
-    K: control.StateSpace
-
-
-class _OverRelaxation:
-    """The D-step's choice of scalings under ``MusynOptions.dscale_overrelax``.
-
-    Holds the fit behind the current scaled plant and the best iterate's D-step.  At the
-    best iterate the fitted target is ``|D̂_prev| (d / |D̂_prev|)^α``; after an iterate that
-    is not the best, one plain step from the best iterate (α halved towards 1 from then
-    on); if that restart does not beat the best either, a plain step from where the loop
-    is, since repeating the restart would repeat it exactly.
-    """
-
-    def __init__(self, alpha: float):
-        self.alpha = alpha
-        self._fit_mag = None  # |D̂(jω)| per block of the fit behind the current plant
-        self._best = None  # _DStep of the best iterate
-        self._restarted_from = None  # the iterate the previous D-step restarted from
-
-    def step(self, it: int, best_it: int, here: _DStep):
-        """``(source, target)``: the D-step to build the next plant around, and the
-        scalings to fit."""
-        if self.alpha <= 1.0 and self._best is None:
-            return here, here.d_blocks  # plain D-K iteration
-        if best_it == it:
-            self._best, self._restarted_from = here, None
-            if self._fit_mag is None or self.alpha <= 1.0:
-                return here, here.d_blocks
-            return here, _overrelaxed(here.d_blocks, self._fit_mag, self.alpha)
-        if self._restarted_from == best_it:
-            self._restarted_from = None
-            return here, here.d_blocks
-        self._restarted_from = best_it
-        self._halve()
-        logger.info("musyn: iteration %d is not the best; next D-step from iteration %d, "
-                    "over-relaxation %.3g", it, best_it, self.alpha)
-        return self._best, self._best.d_blocks
-
-    def plain_from(self, it: int) -> None:
-        """The next plant was rebuilt from iterate ``it``'s plain D-step (its K-step
-        failed on the over-relaxed one): what a restart from ``it`` would build, so a
-        restart is not repeated after it; α is halved towards 1, as after a restart."""
-        self._restarted_from = it
-        self._halve()
-
-    def _halve(self) -> None:
-        """α halved towards 1 (the over-relaxation overshot: a restart, or a failed
-        K-step on the over-relaxed plant)."""
-        self.alpha = 1.0 + (self.alpha - 1.0) / 2.0
-
-    def fitted(self, magnitudes: list[np.ndarray]) -> None:
-        """Record the fit the next scaled plant was built with."""
-        self._fit_mag = magnitudes
-
-
 def _dense_grid(omega: np.ndarray, n: int, peak: float, CL) -> np.ndarray:
     """The grid of the reported µ: ``n`` points over the design range, 41 around the
     peak, and 4 per decade from three decades below the loop's slowest pole to two above
@@ -607,7 +471,7 @@ def _dense_grid(omega: np.ndarray, n: int, peak: float, CL) -> np.ndarray:
 def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptions | None = None,
           callback: Callable[[MusynIteration], None] | None = None,
           rng: np.random.Generator | None = None, constraints=(),
-          lyapunov_scales=None, K0=None) -> MusynResult:
+          lyapunov_scales=None, K0=None, steps: DKSteps | None = None) -> MusynResult:
     """µ-synthesis by D-K iteration.
 
     Parameters
@@ -664,6 +528,14 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         to its start).  A previous design, or one of another method, is a natural
         start.  Without it, ``method="lmi"`` starts from such a central controller by
         itself (see ``MusynOptions.method``).
+    steps : DKSteps, optional
+        Factories of the three steps (:mod:`lmi_suspension.mu.steps`): the K-step, the
+        D/G-step and the fit, each built once for the run from its
+        :class:`~lmi_suspension.mu.steps.DKSetup`.  The defaults are
+        ``MusynOptions.method``'s H∞ synthesis (the multi-objective LMI with
+        ``constraints``), :func:`mussv` on the grid, and the D (D-K) or D-G (D-G-K) fit.
+        Every iterate is certified by this loop whatever the steps: its closed loop's
+        poles, µ bounds, and each constraint recomputed.
 
     Returns
     -------
@@ -682,203 +554,74 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         does not stabilise ``P`` or violates a constraint (``DimensionError`` if its
         size is not ``ncon x nmeas``, ``DiscreteTimeError`` if it is discrete).
     """
-    # hinfsyn with the Riccati search heuristics of the K-steps (probes, brackets)
-    from ..synthesis.hinfsyn import _hinfsyn as hinfsyn
-    from .dfit import fit_dscales, scaled_plant
+    from ..synthesis.hinfsyn import _hinfsyn as hinfsyn  # the D-scale search's
+    from .steps import NextPlant
+    from .steps.dgstep import MussvStep
+    from .steps.fit import default_fit
+    from .steps.kstep import GivenFirst, default_kstep
 
     t_start = time.perf_counter()
-    opts = options if options is not None else MusynOptions()
-    rng = rng if rng is not None else np.random.default_rng(0)
-    P, blk = _with_uncertainty(P, blk, nmeas, ncon)
-    G = GeneralizedPlant.from_statespace(P, nmeas, ncon)
-    struct = BlockStructure.coerce(blk)
-    constraints = tuple(constraints)
-    nz_mu, nw_mu = struct.shape_M
-    if constraints:
-        fits = nz_mu <= G.nz and nw_mu <= G.nw
-        if opts.method != "lmi":
-            raise ParameterError("constraints ride in the LMI K-step: they need "
-                                 f"method='lmi', got {opts.method!r}")
-    else:
-        fits = (nz_mu, nw_mu) == (G.nz, G.nw)
-    if not fits:
-        raise DimensionError(
-            f"block structure needs F_l(P, K) of size {nz_mu}x{nw_mu} "
-            f"(Σc x Σr); the plant's w -> z part is {G.nz}x{G.nw}")
-    free = (G.nw - nw_mu, G.nz - nz_mu)  # channels of the constraints alone
-    if lyapunov_scales is not None and len(tuple(lyapunov_scales)) != len(constraints):
-        raise ParameterError(f"lyapunov_scales must hold one scale per constraint "
-                             f"({len(constraints)}), got {lyapunov_scales!r}")
-    # D-G-K keeps real blocks real (their G scalings absorbed into the scaled plant,
-    # :mod:`.gfit`); complexify=True treats them as complex discs, as D-K always did
-    mixed = not opts.complexify and any(b.is_real for b in struct.blocks)
-    dk_struct = struct if mixed else _complexified(struct)
-    given = None if K0 is None else _initial_controller(K0, G, struct, constraints)
-    omega = default_omega(G) if omega is None else as_finite_array(omega, "omega").ravel()
-    if omega.size < 3 or np.any(omega <= 0) or np.any(np.diff(omega) <= 0):
-        raise ParameterError("omega must hold at least 3 strictly increasing positive frequencies")
+    setup, given = _setup(P, nmeas, ncon, blk, omega, options, rng, constraints,
+                          lyapunov_scales, K0)
+    opts, rng, omega, struct, constraints, mixed, G = (
+        setup.options, setup.rng, setup.omega, setup.struct, setup.constraints,
+        setup.mixed, setup.G)
+    steps = steps if steps is not None else DKSteps()
+    kstep = (steps.kstep or default_kstep)(setup)
+    if given is not None:
+        kstep = GivenFirst(given, kstep)
+    dgstep = (steps.dgstep or MussvStep)(setup)
+    fitstep = (steps.fit or default_fit)(setup)
 
-    PD = G.sys
     history: list[MusynIteration] = []
     best = None  # (mu_peak, K, index)
     stop_reason = f"reached max_iter={opts.max_iter}"
     since_best = 0
-    K_prev = None
-    # (over-relaxation extrapolates D alone; D-G-K steps are plain)
-    relax = _OverRelaxation(1.0 if mixed else float(opts.dscale_overrelax))
-    gamma_next = None  # K_prev's norm on the next scaled plant, when the D-step has it
-    scales = lyapunov_scales  # the constrained K-step's, searched once, then reused
-    plain_next = None  # the plain D-step's (fit, plant) when the next plant is over-relaxed
+    nxt = NextPlant(PD=G.sys, orders=(), K_ref=None)  # the plant of the next K-step
     for it in range(1, int(opts.max_iter) + 1):
         t0 = time.perf_counter()
-        # what the previous controller achieves on the new scaled plant (computed by the
-        # D-step already when it checked an over-relaxed fit)
-        if gamma_next is not None:
-            gamma_prev = gamma_next
-        else:
-            gamma_prev = (float(hinfnorm(_mu_part(lft(PD, K_prev, nmeas, ncon), struct))[0])
-                          if K_prev is not None else float("nan"))
-        gamma_next = None
-        syn, failure = None, None
-        while syn is None:
-            try:
-                if it == 1 and given is not None:
-                    syn = given
-                elif constraints:
-                    syn = _constrained_k_step(PD, nmeas, ncon, opts, struct, constraints,
-                                              scales)
-                    scales = syn.lyapunov_scales
-                else:
-                    syn = _k_step(hinfsyn, PD, nmeas, ncon, opts, gamma_prev)
-                    if it == 1:
-                        syn = _central_start(hinfsyn, PD, nmeas, ncon, opts, syn)
-            except LmiSuspensionError as exc:
-                if best is None:
-                    raise
-                if plain_next is None:
-                    failure = exc
-                    break
-                # an over-relaxed plant the K-step cannot handle (distillation: a
-                # controller LMI that failed at every level on the plant of iteration 3,
-                # 2026-11-25): the plain D-step's plant instead, once
-                logger.info("musyn: K-step failed on the over-relaxed plant of iteration "
-                            "%d (%s); plain D-step instead", it, exc)
-                try:
-                    dfit, PD = plain_next()
-                except LmiSuspensionError as fit_exc:
-                    failure = fit_exc
-                    break
-                plain_next = None
-                relax.fitted(_fit_magnitudes(dfit, omega))
-                relax.plain_from(it - 1)
-                gamma_prev = float(hinfnorm(_mu_part(lft(PD, K_prev, nmeas, ncon),
-                                                     struct))[0])
+        syn, nxt, gamma_prev, failure = _k_step_on(kstep, nxt, it, setup,
+                                                   first=best is None)
         if failure is not None:
             stop_reason = f"K-step failed at iteration {it}: {failure}"
             logger.warning("musyn: %s; keeping iteration %d", stop_reason, best[2])
             break
-        plain_next = None
         K = syn.K
         t1 = time.perf_counter()
         CL_full = lft(G, K)
-        CL = _mu_part(CL_full, struct)
-        certs = _certificates(constraints, CL_full)
+        CL = mu_part(CL_full, struct)
+        certs = certificates(constraints, CL_full)
         if not np.all(np.real(CL.poles()) < 0):
             if best is None:
                 raise InfeasibleError("the first K-step did not give a stabilising controller")
             stop_reason = f"K-step at iteration {it} returned a non-stabilising controller"
             break
-        M = freqresp(CL, omega)  # one response for the D-step and the D-fit check
-        mu, lower_peak = _mu_bounds(CL, dk_struct, omega, rng, M)
+        here = dgstep(CL, K)
         t2 = time.perf_counter()
-        upper = np.asarray(mu.upper)
-        k_peak = int(np.argmax(upper))
-        mu_peak = float(upper[k_peak])
-        peak_omega = float(omega[k_peak])
-        if constraints:
-            # a constrained K-step's loops can have lightly damped poles whose sharp µ
-            # peak falls between grid points (the seat: 1.22 on a 50-point grid, 2.36 on
-            # the dense one, 2026-11-25); µ is also taken at those poles' frequencies
-            res_w = _resonances(CL, omega)
-            if res_w.size:
-                from .bounds import mussv
-
-                at = mussv(freqresp(CL, res_w), dk_struct, omega=res_w, rng=rng)
-                k_res = int(np.argmax(at.upper))
-                if at.upper[k_res] > mu_peak:
-                    mu_peak, peak_omega = float(at.upper[k_res]), float(res_w[k_res])
-                lower_peak = max(lower_peak, float(np.max(at.lower)))
+        mu_peak = here.mu_peak
 
         improved = best is None or mu_peak < best[0] * (1 - opts.min_improvement)
         if (best is None or mu_peak < best[0]) and all(c.met for c in certs):
             if best is None:  # where the D-scale search starts (see ``dscale_search``)
-                first_dstep = (mu.d_blocks, upper)
+                first_dstep = (here.d_blocks, here.upper)
             best = (mu_peak, K, it)
         elif best is None:
             raise InfeasibleError("the first K-step's controller violates " + "; ".join(
                 f"{c.name} ({c.achieved:.6g})" for c in certs if not c.met))
         since_best = 0 if improved else since_best + 1
 
-        done = None
-        # (a constrained K-step's common Lyapunov matrix may well not reach the previous
-        # controller's level: not a loss of accuracy)
-        regressed = (opts.stop_on_kstep_regression and np.isfinite(gamma_prev)
-                     and not constraints
-                     and syn.gamma > gamma_prev * (1 + _KSTEP_RTOL)
-                     # over-relaxed scalings can give a plant the K-step handles badly;
-                     # the next D-step then restarts from the best iterate instead
-                     and not (relax.alpha > 1.0 and best[2] != it))
-        if mu_peak < opts.mu_target:
-            done = f"µ peak {mu_peak:.4f} below target {opts.mu_target}"
-        elif regressed:
-            done = (f"the K-step at iteration {it} is worse on the scaled plant than the "
-                    f"previous controller (gamma {syn.gamma:.4f} > {gamma_prev:.4f}): it "
-                    "has lost accuracy on this scaled plant")
-            logger.warning("musyn: %s", done)
-        elif since_best >= opts.patience:
-            done = f"no improvement of {opts.min_improvement:.1%} in {opts.patience} iterations"
-        elif it == opts.max_iter:
-            done = stop_reason
+        # over-relaxed scalings can give a plant the K-step handles badly; the next
+        # D-step then restarts from the best iterate instead
+        excused = getattr(fitstep, "restarts_from_best", False) and best[2] != it
+        done = _done(setup, it, mu_peak, float(syn.gamma), gamma_prev, since_best,
+                     excused=excused)
 
         orders: tuple = ()
-        K_ref = K  # the controller the next scaled plant is built around
         t3 = time.perf_counter()
         if done is None:
-            src, d_target = relax.step(it, best[2], _DStep(M, mu.d_blocks, upper, mu_peak, K))
-            M_s, d_plain, upper_s, peak_s, K_ref = src
-            # Emphasise the frequencies that set the peak: the fit matters most there.
-            weights = 0.2 + upper_s / peak_s
-
-            def scaled(d):
-                if mixed:  # central D-G scalings at the peak level, both fitted
-                    return _dg_scaled(G.sys, nmeas, ncon, struct, free, M_s, peak_s,
-                                      omega, weights, opts, K_ref)
-                fit = fit_dscales(omega, d, max_order=opts.max_dfit_order,
-                                  rtol=opts.dfit_rtol, weights=weights,
-                                  mu_check=lambda fits: _scaled_peak(fits, M_s, omega, dk_struct),
-                                  mu_peak=peak_s)
-                return fit, _scaled(G.sys, nmeas, ncon, fit, dk_struct, free)
-
             try:
-                dfit, PD_next = scaled(d_target)
-                if d_target is not d_plain:
-                    # the grid check of the fit cannot see what the fit does between and
-                    # beyond the grid points; the controller's norm on the new scaled
-                    # plant can (an extrapolated fit on a coarse grid gave 1739 there
-                    # against 1.04 on the grid, measured)
-                    gamma_next = float(hinfnorm(_mu_part(lft(PD_next, K_ref, nmeas, ncon),
-                                                         struct))[0])
-                    if not gamma_next <= dfit.mu_value * (1 + _OFFGRID_RTOL):
-                        logger.info("musyn: over-relaxed D-fit peaks off the grid (%.4g "
-                                    "against %.4g); plain D-step instead", gamma_next,
-                                    dfit.mu_value)
-                        dfit, PD_next = scaled(d_plain)
-                        gamma_next = None
-                PD = PD_next
-                if d_target is not d_plain and gamma_next is not None:
-                    plain_next = functools.partial(scaled, d_plain)
-                orders = tuple(max(o) for o in dfit.orders)
-                relax.fitted(_fit_magnitudes(dfit, omega))
+                nxt = fitstep(here, iteration=it, best_iteration=best[2])
+                orders = nxt.orders
             except LmiSuspensionError as exc:
                 # no usable scaled plant for the next K-step: end with the best iterate
                 done = f"D-fit failed after iteration {it}: {exc}"
@@ -886,14 +629,13 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         t4 = time.perf_counter()
         record = MusynIteration(
             index=it, gamma=float(syn.gamma), mu_peak=mu_peak,
-            mu_lower_peak=lower_peak, peak_omega=peak_omega,
+            mu_lower_peak=here.lower_peak, peak_omega=here.peak_omega,
             dfit_orders=orders, controller_order=K.nstates, seconds_k=t1 - t0,
             seconds_d=t2 - t1, seconds_fit=t4 - t3,
             warnings=tuple(syn.warnings) + (() if mixed and it > 1 else _bound_check(
-                float(syn.gamma), lower_peak, f"iteration {it}")),
+                float(syn.gamma), here.lower_peak, f"iteration {it}")),
             gamma_prev=gamma_prev, K=K, certificates=certs)
         history.append(record)
-        K_prev = K_ref
         logger.info("musyn iteration %d: gamma=%.4f (previous K %.4f) mu=%.4f (lower %.4f) "
                     "K order %d D orders %s [K %.2fs, D %.2fs, fit %.2fs]", it, record.gamma,
                     gamma_prev, mu_peak, record.mu_lower_peak, K.nstates, orders,
@@ -910,7 +652,7 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
     elif opts.dscale_search and best[0] >= opts.mu_target and mixed:
         logger.info("musyn: no D-scale search with real blocks (it searches D alone)")
     elif opts.dscale_search and best[0] >= opts.mu_target:
-        found = _search_stage(G, nmeas, ncon, dk_struct, omega, first_dstep, opts, rng,
+        found = _search_stage(G, nmeas, ncon, setup.dk_struct, omega, first_dstep, opts, rng,
                               index=len(history) + 1, hinfsyn=hinfsyn)
         if found is not None:
             history.append(found)
@@ -920,9 +662,19 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
                 best = (found.mu_peak, found.K, found.index)
                 stop_reason += f"; D-scale search to µ {found.mu_peak:.4f}"
 
-    mu_best, K, best_it = best
+    return _certified(setup, best, history, stop_reason, t_start)
+
+
+def _certified(setup, best, history, stop_reason: str, t_start: float) -> MusynResult:
+    """The best iterate's result: its µ on a dense grid with the true structure (the
+    peak refined with the LMI bound, bounded between grid points), its controller
+    reduced where asked and µ allows, its constraints recomputed."""
+    _, K, best_it = best
+    G, struct, omega, opts, rng, constraints, mixed = (
+        setup.G, setup.struct, setup.omega, setup.options, setup.rng, setup.constraints,
+        setup.mixed)
     CL_full = lft(G, K)
-    CL = balanced_statespace(_mu_part(CL_full, struct))
+    CL = balanced_statespace(mu_part(CL_full, struct))
     dense = _dense_grid(omega, int(opts.n_dense), history[best_it - 1].peak_omega, CL)
     final = _final_bounds(CL, struct, dense, rng)
     reduced_from = None
@@ -930,9 +682,9 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         K_red = _try_reduce(K, int(opts.reduce_order))
         if K_red is not None:
             CL_red_full = lft(G, K_red)
-            CL_red = balanced_statespace(_mu_part(CL_red_full, struct))
+            CL_red = balanced_statespace(mu_part(CL_red_full, struct))
             if np.all(np.real(CL_red.poles()) < 0) and all(
-                    c.met for c in _certificates(constraints, CL_red_full)):
+                    c.met for c in certificates(constraints, CL_red_full)):
                 final_red = _final_bounds(CL_red, struct, dense, rng)
                 if np.max(final_red.upper) <= np.max(final.upper) * (1 + opts.reduce_mu_tol):
                     reduced_from = K.nstates
@@ -965,7 +717,108 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         history=tuple(history),
         best_iteration=best_it, stop_reason=stop_reason, reduced_from=reduced_from,
         seconds=time.perf_counter() - t_start, omega=omega,
-        certificates=_certificates(constraints, CL_full), warnings=checks)
+        certificates=certificates(constraints, CL_full), warnings=checks)
+
+
+
+def _setup(P, nmeas, ncon, blk, omega, options, rng, constraints, lyapunov_scales, K0):
+    """``musyn``'s arguments checked and gathered: ``(DKSetup, K0 checked or None)``."""
+    from .steps import DKSetup
+    from .steps.kstep import initial_controller
+
+    opts = options if options is not None else MusynOptions()
+    rng = rng if rng is not None else np.random.default_rng(0)
+    P, blk = _with_uncertainty(P, blk, nmeas, ncon)
+    G = GeneralizedPlant.from_statespace(P, nmeas, ncon)
+    struct = BlockStructure.coerce(blk)
+    constraints = tuple(constraints)
+    nz_mu, nw_mu = struct.shape_M
+    if constraints:
+        fits = nz_mu <= G.nz and nw_mu <= G.nw
+        if opts.method != "lmi":
+            raise ParameterError("constraints ride in the LMI K-step: they need "
+                                 f"method='lmi', got {opts.method!r}")
+    else:
+        fits = (nz_mu, nw_mu) == (G.nz, G.nw)
+    if not fits:
+        raise DimensionError(
+            f"block structure needs F_l(P, K) of size {nz_mu}x{nw_mu} "
+            f"(Σc x Σr); the plant's w -> z part is {G.nz}x{G.nw}")
+    if lyapunov_scales is not None and len(tuple(lyapunov_scales)) != len(constraints):
+        raise ParameterError(f"lyapunov_scales must hold one scale per constraint "
+                             f"({len(constraints)}), got {lyapunov_scales!r}")
+    # D-G-K keeps real blocks real (their G scalings absorbed into the scaled plant,
+    # :mod:`.gfit`); complexify=True treats them as complex discs, as D-K always did
+    mixed = not opts.complexify and any(b.is_real for b in struct.blocks)
+    given = None if K0 is None else initial_controller(K0, G, struct, constraints)
+    omega = default_omega(G) if omega is None else as_finite_array(omega, "omega").ravel()
+    if omega.size < 3 or np.any(omega <= 0) or np.any(np.diff(omega) <= 0):
+        raise ParameterError("omega must hold at least 3 strictly increasing positive frequencies")
+    setup = DKSetup(G=G, struct=struct, dk_struct=struct if mixed else _complexified(struct),
+                    mixed=mixed, free=(G.nw - nw_mu, G.nz - nz_mu), omega=omega,
+                    options=opts, rng=rng, constraints=constraints,
+                    lyapunov_scales=None if lyapunov_scales is None else tuple(lyapunov_scales))
+    return setup, given
+
+
+def _done(setup, it: int, mu_peak: float, gamma: float, gamma_prev: float,
+          since_best: int, *, excused: bool) -> str | None:
+    """Why D-K stops after iteration ``it``, or None: µ below target; a K-step worse on
+    its scaled plant than the previous controller (it has lost accuracy, unless
+    ``excused``; a constrained K-step's common Lyapunov matrix may well not reach the
+    previous controller's level); patience; ``max_iter``."""
+    opts = setup.options
+    regressed = (opts.stop_on_kstep_regression and np.isfinite(gamma_prev)
+                 and not setup.constraints and not excused
+                 and gamma > gamma_prev * (1 + _KSTEP_RTOL))
+    if mu_peak < opts.mu_target:
+        return f"µ peak {mu_peak:.4f} below target {opts.mu_target}"
+    if regressed:
+        done = (f"the K-step at iteration {it} is worse on the scaled plant than the "
+                f"previous controller (gamma {gamma:.4f} > {gamma_prev:.4f}): it has lost "
+                "accuracy on this scaled plant")
+        logger.warning("musyn: %s", done)
+        return done
+    if since_best >= opts.patience:
+        return f"no improvement of {opts.min_improvement:.1%} in {opts.patience} iterations"
+    if it == opts.max_iter:
+        return f"reached max_iter={opts.max_iter}"
+    return None
+
+
+def _k_step_on(kstep, nxt, it: int, setup, *, first: bool):
+    """The K-step of iteration ``it`` on ``nxt``'s plant: ``(syn, nxt, gamma_prev,
+    failure)``.  Where it fails and the fit step left a plainer plant (over-relaxation's
+    fallback), it runs once more on that one; ``failure`` is the error that ends D-K
+    (raised instead at the first iteration, where there is no iterate to keep)."""
+    gamma_prev = _previous_level(nxt, setup)
+    while True:
+        try:
+            return kstep(nxt.PD, iteration=it, gamma_prev=gamma_prev), nxt, gamma_prev, None
+        except LmiSuspensionError as exc:
+            if first:
+                raise
+            if nxt.fallback is None:
+                return None, nxt, gamma_prev, exc
+            logger.info("musyn: K-step failed on the plant of iteration %d (%s); the fit "
+                        "step's plainer plant instead", it, exc)
+            try:
+                nxt = nxt.fallback()
+            except LmiSuspensionError as fit_exc:
+                return None, nxt, gamma_prev, fit_exc
+            gamma_prev = _previous_level(nxt, setup)
+
+
+def _previous_level(nxt, setup) -> float:
+    """The previous controller's norm on the next scaled plant (NaN before the first
+    K-step): where a K-step that does not reach it has lost accuracy.  The fit step may
+    have computed it already."""
+    if nxt.gamma is not None:
+        return nxt.gamma
+    if nxt.K_ref is None:
+        return float("nan")
+    return float(hinfnorm(mu_part(lft(nxt.PD, nxt.K_ref, setup.nmeas, setup.ncon),
+                                  setup.struct))[0])
 
 
 def _with_uncertainty(P, blk, nmeas: int, ncon: int):
@@ -991,132 +844,6 @@ def _with_uncertainty(P, blk, nmeas: int, ncon: int):
                              "musyn needs at least one of each")
     rows = ([] if data.blk is None else data.blk.to_blk().tolist()) + [[nd, ne]]
     return data.M, rows
-
-
-class _GivenController(NamedTuple):
-    """``musyn``'s ``K0`` in the place of the first K-step's result."""
-
-    K: control.StateSpace
-    gamma: float
-    warnings: tuple = ("initial controller K0: no K-step",)
-
-
-def _initial_controller(K0, G: GeneralizedPlant, struct: BlockStructure,
-                        constraints) -> _GivenController:
-    """``K0`` checked against ``G`` (size, stability of the loop, constraints), with its
-    certified norm on the µ channels."""
-    from ..lti.checks import as_statespace
-
-    K = as_statespace(K0, "K0")
-    if (K.noutputs, K.ninputs) != (G.nu, G.ny):
-        raise DimensionError(f"K0 must have {G.nu} outputs and {G.ny} inputs (u = K0 y), "
-                             f"got {K.noutputs} x {K.ninputs}")
-    CL_full = lft(G, K)
-    p = np.linalg.eigvals(np.asarray(CL_full.A)) if CL_full.nstates else np.zeros(0)
-    if not np.all(np.real(p) < 0):
-        raise ParameterError(f"K0 does not stabilise P (closed-loop pole with real part "
-                             f"{np.max(np.real(p)):.3g})")
-    unmet = [c for c in _certificates(constraints, CL_full) if not c.met]
-    if unmet:
-        raise ParameterError("K0 violates " + "; ".join(
-            f"{c.name} ({c.achieved:.6g})" for c in unmet))
-    return _GivenController(K, float(hinfnorm(_mu_part(CL_full, struct))[0]))
-
-
-def _resonances(CL: control.StateSpace, omega: np.ndarray) -> np.ndarray:
-    """Frequencies (rad/s) of the loop's lightly damped poles (damping ζ below 0.3)
-    within the design range: each pole's |p| and |Im p|, and the edges ``|p| (1 ± ζ)`` of
-    its half-power band."""
-    p = np.linalg.eigvals(np.asarray(CL.A)) if CL.nstates else np.zeros(0)
-    p = p[p.imag > 0]
-    w = np.abs(p)
-    z = -p.real / w
-    keep = (z < 0.3) & (w >= omega[0]) & (w <= omega[-1])
-    p, w, z = p[keep], w[keep], z[keep]
-    if not w.size:
-        return np.zeros(0)
-    pts = np.concatenate([w, w * (1 - z), w * (1 + z), p.imag])
-    return np.unique(pts[pts > 0])
-
-
-def _mu_part(CL: control.StateSpace, struct: BlockStructure) -> control.StateSpace:
-    """The ``w -> z`` part of a closed loop that ``struct`` covers (its first rows and
-    columns); the closed loop itself when there are no constraint channels."""
-    nz, nw = struct.shape_M
-    if (CL.noutputs, CL.ninputs) == (nz, nw):
-        return CL
-    return control.ss(CL.A, np.asarray(CL.B)[:, :nw], np.asarray(CL.C)[:nz],
-                      np.asarray(CL.D)[:nz, :nw])
-
-
-def _certificates(constraints, CL_full) -> tuple:
-    """Each constraint recomputed on the unscaled closed loop, independently of the
-    K-step's own certificates (which are on the scaled plant)."""
-    from ..synthesis.multiobjective import _certify
-
-    return tuple(_certify(c, CL_full, c.bound, c.bound) for c in constraints)
-
-
-def _scaled(G, nmeas, ncon, fit, struct, free):
-    """The D-scaled plant; the constraint channels (``free`` inputs and outputs beyond
-    ``blk``) pass unscaled."""
-    from .dfit import scaled_plant
-
-    sizes = _block_sizes(struct)
-    if any(free):
-        unit = control.ss([], [], [], [[1.0]])
-        fit = replace(fit, fits=tuple(fit.fits) + (unit,), orders=tuple(fit.orders) + ((0,),),
-                      errors=tuple(fit.errors) + (0.0,))
-        sizes = sizes + [free]
-    return scaled_plant(G, nmeas, ncon, fit, sizes)
-
-
-def _dg_scaled(G, nmeas, ncon, struct, free, M, beta, omega, weights, opts, K_ref):
-    """D-G-K's next plant (:mod:`.gfit`): the central D-scalings of the loop ``M`` at
-    level ``beta``, fitted; then the G-scalings that minimise the level of ``K_ref``'s
-    D-scaled loop on the grid (:func:`~.gfit.optimal_gscales`), absorbed."""
-    from .dfit import fit_dscales
-    from .gfit import central_dg, gscaled_plant, optimal_gscales
-
-    d, _, _ = central_dg(M, struct, beta)
-    fit = fit_dscales(omega, d, max_order=opts.max_dfit_order, rtol=opts.dfit_rtol,
-                      weights=weights)
-    PD = _scaled(G, nmeas, ncon, fit, struct, free)
-    Mt = freqresp(_mu_part(lft(PD, K_ref, nmeas, ncon), struct), omega)
-    gfit = optimal_gscales(omega, Mt, struct, target=beta)
-    logger.info("musyn: D-G scalings at level %.5g for the loop at %.5g", gfit.beta, beta)
-    return fit, gscaled_plant(PD, nmeas, ncon, struct, gfit)
-
-
-def _constrained_k_step(PD, nmeas, ncon, opts, struct, constraints, scales):
-    """The multi-objective LMI K-step: the scaled µ channels' H∞ norm minimised subject
-    to ``constraints``.  The Lyapunov scales are searched on the first K-step and reused
-    after (the search costs ~15 minimisations), searched again if they fail."""
-    from ..synthesis.constraints import Channel, HinfBound
-    from ..synthesis.multiobjective import msyn
-
-    nz, nw = struct.shape_M
-    objective = HinfBound(Channel(outputs=tuple(range(nz)), inputs=tuple(range(nw))),
-                          name="scaled µ channels")
-    if scales is not None:
-        try:
-            return _KStep(msyn(PD, nmeas, ncon, objective, constraints,
-                               options=opts.hinfsyn_options, lyapunov_scales=scales))
-        except (InfeasibleError, SolverError) as exc:
-            logger.info("musyn: constrained K-step with the previous Lyapunov scales "
-                        "failed (%s); searching them again", exc)
-    return _KStep(msyn(PD, nmeas, ncon, objective, constraints,
-                       options=opts.hinfsyn_options))
-
-
-class _KStep:
-    """A constrained K-step's result in the shape the loop reads (``K``, ``gamma``,
-    ``warnings``)."""
-
-    def __init__(self, res):
-        self.K, self.gamma = res.K, res.objective
-        self.warnings = res.warnings
-        self.lyapunov_scales = res.lyapunov_scales
 
 
 def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hinfsyn):
@@ -1146,7 +873,7 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
                                [g * (1.0 + r) for r in _SEARCH_LEVELS])[0]
 
     t0 = time.perf_counter()
-    found = search_dscales(G.sys, nmeas, ncon, _block_sizes(struct), omega, d_blocks,
+    found = search_dscales(G.sys, nmeas, ncon, block_sizes(struct), omega, d_blocks,
                            0.2 + upper / np.max(upper), int(opts.max_dfit_order), level,
                            controller, check=check, max_evals=int(opts.dscale_search),
                            target=float(opts.mu_target))
@@ -1175,258 +902,6 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
                   f"{found.gamma:.6g}",)
         + _bound_check(found.gamma, lower_peak, "D-scale search"),
         gamma_prev=found.level_start, K=found.K, stage="dscale_search")
-
-
-def _gramian_balanced(PD: control.StateSpace) -> control.StateSpace | None:
-    """A balanced realization of the scaled plant (python-control ``balred`` at full
-    order: the stable part balanced, states with negligible Hankel singular values
-    dropped), or None when slycot fails.
-
-    SLICOT's Riccati solver works on the realization it is given: on a D-scaled
-    distillation plant (poles from 1e-6 to 2e3 rad/s, Riccati rcond ≈ 1e-11) it found no
-    controller below γ ≈ 1.3 in the coordinates of the series connection, where the
-    previous controller certifies 1.01; in balanced coordinates it returned a controller
-    certifying 1.0099 (measured).
-    """
-    try:
-        with warnings.catch_warnings():
-            # slycot says when the minimal order is below the requested one
-            warnings.simplefilter("ignore")
-            return control.balred(PD, PD.nstates, method="truncate")
-    except Exception as exc:  # slycot raises plain ValueError/ArithmeticError variants
-        logger.info("musyn: no balanced realization of the scaled plant (%s)", exc)
-        return None
-
-
-#: levels, relative to the lowest level SLICOT achieved on a Gramian-balanced realization,
-#: whose controllers are judged on the scaled plant itself (see :func:`_riccati_balanced`)
-_BALANCED_LEVELS = (0.0, 3e-4, 1e-3, 3e-3)
-#: level, relative to a point's own, of the SLICOT controller whose certified norm
-#: checks each point the D-scale search accepts (:mod:`.dsearch`)
-_CHECK_LEVEL = 1e-3
-#: levels above the best point's, relative, whose SLICOT controllers the search certifies
-#: (the lowest certified one is returned); at the level itself they are ill-conditioned.
-#: They are designed on the scaled plant and on its balanced realization: near the
-#: optimum SLICOT's controller misses its own level, by an amount that moves with the
-#: OpenBLAS kernel.  At the same best point (level 0.970688, reached from one start on
-#: Haswell and Sandybridge), the balanced realization's best controllers certified
-#: +0.10 % and +0.99 % above it, the scaled plant's +0.10 % and +0.03 %: 0.9 % apart
-#: between the kernels with the balanced realization alone, 0.07 % with both (measured
-#: 2026-11-26).  The balanced one stays because on other scaled plants it is the only
-#: one SLICOT solves near the optimum (:func:`_gramian_balanced`)
-_SEARCH_LEVELS = (3e-4, 1e-3, 3e-3, 1e-2)
-
-
-def _riccati_balanced(hinfsyn, PD, nmeas: int, ncon: int, options, *, probes: tuple = (),
-                      bracket: tuple | None = None):
-    """Riccati on a Gramian-balanced realization of ``PD``, judged on ``PD`` itself.
-
-    Returns the balanced realization's :class:`HinfsynResult` with the controller kept,
-    its certified γ, closed loop and poles on ``PD`` (``gamma_solver`` stays SLICOT's
-    lowest achieved level); None when there is no balanced realization.  The
-    bisection's own choice is certified on the balanced realization, which can be off
-    near DC where the scaled plant has poles near 1e-6 rad/s: with the book's optimal
-    D-scales, the controller at the lowest achieved level certifies 0.97401 on ``PD``
-    but 1.0034 on the realization, and the bisection returned one certifying 0.97688
-    on ``PD`` (measured 2026-11-24; the same code gave 0.97395 the day before).  So the
-    controllers at a few levels just above that level are certified on ``PD`` too
-    (SLICOT's suboptimal formulas, ``sb10ad`` job 4: a few milliseconds each) and the
-    best one is kept.
-    """
-    plant = _gramian_balanced(PD)
-    if plant is None:
-        return None
-    res = hinfsyn(plant, nmeas, ncon, method="riccati", options=options, probes=probes,
-                  bracket=bracket)
-    levels = [] if options.gamma is not None else \
-        [res.gamma_solver * (1.0 + r) for r in _BALANCED_LEVELS]
-    K, CL, gamma = _best_certified(hinfsyn, PD, (plant,), nmeas, ncon, options, levels,
-                                   first=res.K)
-    return replace(res, K=K, gamma=gamma, CL=CL, poles=np.linalg.eigvals(np.asarray(CL.A)),
-                   controller_fastest_pole=(float(np.max(np.abs(np.linalg.eigvals(K.A))))
-                                            if K.nstates else 0.0),
-                   warnings=res.warnings + (
-                       "Riccati on a Gramian-balanced realization of the scaled plant; "
-                       f"certified {gamma:.6g} on the plant itself",))
-
-
-def _best_certified(hinfsyn, PD, realizations, nmeas: int, ncon: int, options, levels, *,
-                    first=None):
-    """SLICOT's controllers of each of ``realizations`` (of ``PD``) at fixed ``levels``
-    (and ``first``, if given), each certified on ``PD``: ``(K, CL, gamma)`` of the one
-    with the lowest certified norm.  Raises the last error if none is found."""
-    candidates = [] if first is None else [first]
-    error = None
-    for plant in realizations:
-        for level in levels:
-            try:
-                candidates.append(hinfsyn(plant, nmeas, ncon, method="riccati",
-                                          options=replace(options, gamma=level)).K)
-            except LmiSuspensionError as exc:
-                error = exc
-    if not candidates:
-        raise error if error is not None else ParameterError("no level to try")
-    loops = [(lft(PD, K, nmeas, ncon), K) for K in candidates]
-    gammas = [float(hinfnorm(CL)[0]) for CL, _ in loops]
-    k = int(np.argmin(gammas))
-    return loops[k][1], loops[k][0], gammas[k]
-
-
-def _central_start(hinfsyn, P, nmeas: int, ncon: int, opts: MusynOptions, syn):
-    """The first iterate of D-K with the LMI K-step: the central controller at
-    ``(1 + _CENTRAL_START_RELAX)`` times the level the LMI certified (SLICOT ``sb10ad``
-    at that fixed γ), certified on ``P``; the LMI's own controller where it is not
-    certified at that level or ``method`` is not ``"lmi"`` or γ is fixed.
-
-    Among the controllers that achieve about the optimal γ, the D-step sees a different
-    closed loop from each, and the D-K path depends on which (:func:`musyn`'s ``K0``).
-    On the distillation problem the central (minimum-entropy) controller just above
-    the optimum led the LMI K-steps that follow to µ 0.974-0.981 under every OpenBLAS
-    kernel, against 1.035-1.037 from the LMI's own largest-margin controller
-    (``_CENTRAL_START_RELAX``).  Every later K-step is the LMI's.
-    """
-    base = _kstep_options(opts)
-    if opts.method != "lmi" or base.gamma is not None or not np.isfinite(syn.gamma):
-        return syn
-    level = float(syn.gamma) * (1.0 + _CENTRAL_START_RELAX)
-    try:
-        central = hinfsyn(P, nmeas, ncon, method="riccati", options=replace(base, gamma=level))
-    except LmiSuspensionError as exc:
-        logger.info("musyn: no central controller at %.6g (%s); the LMI's first controller",
-                    level, exc)
-        return syn
-    if not central.gamma <= level * (1.0 + _KSTEP_RTOL):
-        logger.info("musyn: the central controller at %.6g certifies %.6g; the LMI's first "
-                    "controller", level, central.gamma)
-        return syn
-    return replace(central, warnings=tuple(central.warnings) + (
-        f"first iterate: the central controller at {level:.6g} "
-        f"({_CENTRAL_START_RELAX:.0%} above the LMI's certified {syn.gamma:.6g}), "
-        f"certified {central.gamma:.6g}",))
-
-
-def _kstep_options(opts: MusynOptions):
-    """The options of every K-step: the user's, or the bisection Riccati search."""
-    from ..synthesis import HinfsynOptions
-
-    return (opts.hinfsyn_options if opts.hinfsyn_options is not None
-            else HinfsynOptions(riccati_search="bisection"))
-
-
-def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base):
-    """The LMI K-step at a level fixed in advance: ``(1 + _LEVEL_RELAX)`` times the γ
-    certified for SLICOT's controller (Riccati bisection, 0.03-0.15 s here); the
-    controller is the LMI's (feasibility, then the controller LMI, at that level),
-    certified on ``PD``.  Returns None where SLICOT finds no controller (the caller
-    then runs the γ minimisation); raises :class:`SolverError` where the LMI finds none
-    at the level within ``_LEVEL_LED_RECOVERIES`` recoveries.
-
-    On the D-scaled plants of the distillation problem the γ minimisation is where the
-    LMI K-step loses its time and its reproducibility (9-70 s on 22 states, γ 1.0113 to
-    1.0298 on one plant across OpenBLAS kernels, measured 2026-11-26); at a level
-    fixed by a certified controller only a feasibility problem is left.  Where even
-    that fails, the γ minimisation is not tried: on the same problem it took 10-17 s
-    per K-step there, and default ``musyn`` (8 OpenBLAS kernel and thread rows) ended
-    at µ 0.9648-0.9772 in 25-75 s with it, at 0.9638-0.9727 in 19-43 s without it
-    (D-K then goes on from the plain D-step's plant, or ends; the D-scale search then
-    started from the best iterate; measured 2026-11-26).
-    """
-    try:
-        ric = hinfsyn(PD, nmeas, ncon, method="riccati",
-                      options=replace(base, riccati_search="bisection"))
-    except LmiSuspensionError as exc:
-        logger.info("musyn: no Riccati level for the LMI K-step (%s)", exc)
-        return None
-    if not np.isfinite(ric.gamma):
-        return None
-    level = float(ric.gamma) * (1.0 + _LEVEL_RELAX)
-    try:
-        res = hinfsyn(PD, nmeas, ncon, method="lmi",
-                      options=replace(base, gamma=level, max_recoveries=min(
-                          int(base.max_recoveries), _LEVEL_LED_RECOVERIES)),
-                      feasibility_recoveries=0)
-    except LmiSuspensionError as exc:
-        raise SolverError(f"the LMI found no controller at {level:.6g}, "
-                          f"{_LEVEL_RELAX:.1%} above the γ certified for SLICOT's "
-                          f"controller ({ric.gamma:.6g}): {exc}") from exc
-    return replace(res, warnings=tuple(res.warnings) + (
-        f"LMI K-step at {level:.6g}, {_LEVEL_RELAX:.1%} above the γ certified for "
-        f"SLICOT's controller ({ric.gamma:.6g})",))
-
-
-def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts: MusynOptions,
-            gamma_prev: float = float("nan")):
-    """H∞ synthesis on the scaled plant. With ``method="best"`` the Riccati route runs on
-    the plant as given and diagonally balanced; unless one of them already certifies at
-    or below ``gamma_prev`` (the previous controller's level), it runs on a
-    Gramian-balanced realization and then the LMI route follows; the controller with the
-    lowest γ *certified on* ``PD`` is kept: each fails on problems another solves
-    (singular D12/D21 for Riccati; D-scaled plants with a slow weight pole, where
-    Clarabel's γ minimisation stalls and any Riccati variant can be the accurate one)."""
-    base = _kstep_options(opts)
-    probes = KSTEP_RICCATI_PROBES  # used by the Riccati route only
-    if opts.method != "best":
-        hint = gamma_prev if opts.method == "lmi" and np.isfinite(gamma_prev) else None
-        if hint is not None and base.gamma is None and base.gamma_abort is None:
-            # the previous controller achieves gamma_prev on PD: a γ minimisation that
-            # stops above it has failed, and reconstructing around it only costs time
-            # (an over-relaxed distillation plant: 53 s of failing controller LMIs,
-            # 2026-11-25)
-            base = replace(base, gamma_abort=hint * (1 + _KSTEP_RTOL))
-        if opts.method == "lmi" and hint is not None and base.gamma is None:
-            led = _level_led_lmi(hinfsyn, PD, nmeas, ncon, base)
-            if led is not None:
-                return led
-        return hinfsyn(PD, nmeas, ncon, method=opts.method, options=base, probes=probes,
-                       level_hint=hint)
-    results, errors = [], []
-
-    def previous_beaten() -> bool:
-        return bool(results) and min(r.gamma for r in results) <= gamma_prev * (1 + _KSTEP_RTOL)
-
-    for method, scale in (("riccati", False), ("riccati", True), ("riccati", "gramian"),
-                          ("lmi", None)):
-        options = replace(base, riccati_scale=scale is True) if method == "riccati" else base
-        if scale == "gramian":
-            if previous_beaten():
-                continue  # only where the other two did not beat the previous controller
-            try:
-                found = _riccati_balanced(hinfsyn, PD, nmeas, ncon, options, probes=probes)
-            except LmiSuspensionError as exc:
-                errors.append(exc)
-                continue
-            if found is not None:
-                results.append(found)
-            continue
-        if method == "lmi" and results and PD.nstates > _LMI_FALLBACK_MAX_STATES:
-            # measured: 29 s at 30 states, 191 s at 40, and gigabytes of KKT data
-            logger.info("musyn: no LMI fallback on a %d-state scaled plant", PD.nstates)
-            break
-        if method == "lmi" and results and base.gamma is None:
-            if previous_beaten():
-                # Riccati already improves on the previous controller; the LMI is the
-                # fallback (on 22-state D-scaled plants its γ minimisation fails and
-                # costs more than the rest of the iteration, measured on distillation)
-                break
-            # an LMI optimum far above a certified Riccati γ is a failed solve: stop early
-            options = replace(base, gamma_abort=2.0 * min(r.gamma for r in results))
-        try:
-            res = hinfsyn(PD, nmeas, ncon, method=method, options=options, probes=probes)
-        except LmiSuspensionError as exc:
-            errors.append(exc)
-            continue
-        results.append(res)
-    if not results:
-        raise errors[0]
-    # Riccati-led: a later route replaces an earlier one only when it certifies lower by
-    # more than _KSTEP_RTOL (the LMI reconstructs 0.05 % above its optimum and would
-    # otherwise win ties on the unscaled distillation plant, where the book's path
-    # follows the Riccati controller: 1.0275 at iteration 2 against 1.057)
-    best = results[0]
-    for res in results[1:]:
-        if res.gamma < best.gamma * (1 - _KSTEP_RTOL):
-            best = res
-    return best
 
 
 def _try_reduce(K: control.StateSpace, order: int):

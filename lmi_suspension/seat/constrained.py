@@ -187,7 +187,7 @@ def certify_constrained(K, *, design: SeatDesignOptions | None = None,
     """
     from ..lti import freqresp, lft
     from ..mu import mussv
-    from ..mu.dk import _mu_part
+    from ..mu.steps import mu_part as _mu_part
     from ..mu.blocks import BlockStructure
 
     E = road_energy(bump()) if energy is None else float(energy)

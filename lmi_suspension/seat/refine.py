@@ -888,7 +888,7 @@ def certify_refined(K, *, Kd=None, delays=REFINE_DELAYS, design: SeatDesignOptio
                                                           u_max=np.inf).z3dd)))
                     for d in delays)
     from ..lti import lft
-    from ..mu.dk import _resonances
+    from ..mu.steps.dgstep import resonances as _resonances
 
     design = DEFAULT_DESIGN if design is None else design
     aug = seat_augmented_plant(design, params)
