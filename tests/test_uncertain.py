@@ -6,6 +6,9 @@ Reference values and their sources:
 - robstab, x'' + c x' + k x: stable iff c > 0 and k > 0 (second-order Routh-Hurwitz);
   third order s^3 + a s^2 + b s + c: stable iff a, c > 0 and a b > c, which gives the
   margin 5 - sqrt(13) in closed form (tests/uncertain_plants.py).
+- robstab, one real parameter (coupled_modes below): a dense sweep of the closed-loop
+  eigenvalues of the matrix built with numbers, then bisection, in the test itself;
+  x'' + c x' + x with c = 1 + 2δ: exact margin 1/2 (c = 0), the robstab docstring.
 - ultidyn: small-gain theorem, margin = 1 / (bound ‖G‖∞) for one SISO full block.
 - wcgain: 1/(s^2 + 2 ζ s + 1) peaks at 1/(2 ζ sqrt(1 - ζ^2)) (ζ < 1/sqrt 2), largest at
   the smallest ζ.
@@ -160,6 +163,7 @@ def test_robstab_refuses_unstable_nominal():
 def test_robstab_snippet_real_pole_at_zero():
     """k = 1 - 0.4 α reaches 0 at α = 2.5 (a pole at s = 0), before m = 0 at α = 10/3."""
     r = robstab(snippet(), W60)
+    assert r.lower <= r.upper
     assert r.lower <= 2.5 * (1 + 1e-9) and r.upper >= 2.5 * (1 - 1e-9)
     assert r.upper / r.lower - 1 < 0.05
     assert r.critical_frequency == pytest.approx(0.0, abs=1e-6)
@@ -170,6 +174,7 @@ def test_robstab_snippet_real_pole_at_zero():
 def test_robstab_third_order_closed_form():
     G = third_uncertain()
     r = robstab(G, W60)
+    assert r.lower <= r.upper
     assert r.lower <= THIRD_MARGIN * (1 + 1e-6) and r.upper >= THIRD_MARGIN * (1 - 1e-6)
     assert r.upper / r.lower - 1 < 0.05
     p = usubs(G, dict(r.worst)).poles()
@@ -186,6 +191,7 @@ def test_robstab_ultidyn_small_gain():
     T = feedback(uss(P), D)
     gP = hinfnorm(P)[0]
     r = robstab(T, W60)
+    assert r.lower <= r.upper
     assert r.lower <= 1 / (0.25 * gP) * 1.001 and r.upper >= 1 / (0.25 * gP) * 0.99
     assert r.upper / r.lower - 1 < 0.05 and r.checked
 
@@ -208,6 +214,93 @@ def test_wcgain_unstable_in_box_is_infinite():
     assert g.lower == np.inf and g.upper == np.inf
 
 
+# ---------------------------------------------------------------- robstab, one real parameter
+#: two lightly damped modes (1 and 3.5 rad/s) coupled by one real parameter through the
+#: rank-one term δ b cᵀ.  Its crossing (0.80 rad/s) falls between the default grid's
+#: frequencies, where the grid's µ bound alone read 1/0.2621 (margin 0.2621 above the
+#: true 0.2386, 2026-11-27): the defect the exact route fixes.
+Z1, Z2, W2 = 0.08, 0.05, 3.5
+B_COUPLE = np.array([-0.78, 0.75, 1.63, 0.27])
+C_COUPLE = np.array([0.42, 1.14, 0.11, -0.55])
+A_MODES = np.array([[0, 1, 0, 0], [-1, -2 * Z1, 0, 0], [0, 0, 0, 1], [0, 0, -W2**2, -2 * Z2 * W2]])
+
+
+def coupled_modes(output_gain=None):
+    """The uncertain model (δ = d, nominal 0, ±1); ``output_gain`` an optional second
+    parameter on the output, which cannot change stability."""
+    d = ureal("d", 0.0, plusminus=1.0)
+    A = [[A_MODES[i, j] + B_COUPLE[i] * C_COUPLE[j] * d for j in range(4)] for i in range(4)]
+    g = 1.0 if output_gain is None else output_gain
+    return uss(A, [[0], [1], [0], [0]], [[g, 0, 0, 0]], [[0]])
+
+
+def coupled_modes_brute_margin(points=4001):
+    """Independent reference: dense sweep of |δ| on both sides of the matrix built with
+    numbers, then bisection of the first unstable interval (abscissa >= 0)."""
+    def unstable(dv):
+        return np.max(np.linalg.eigvals(A_MODES + dv * np.outer(B_COUPLE, C_COUPLE)).real) >= 0
+
+    best = np.inf
+    for s in (1.0, -1.0):
+        ts = np.linspace(0.0, 2.0, points)
+        bad = [t for t in ts if unstable(s * t)]
+        if not bad:
+            continue
+        hi = bad[0]
+        lo = hi - ts[1]
+        for _ in range(80):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (lo, mid) if unstable(s * mid) else (mid, hi)
+        best = min(best, hi)
+    return best
+
+
+def test_robstab_single_real_exact_where_the_grid_steps_over_the_crossing():
+    G = coupled_modes()
+    r = robstab(G)
+    bm = coupled_modes_brute_margin()
+    assert r.method == "exact" and not r.warnings
+    assert r.lower <= bm * (1 + 1e-9) and bm <= r.upper * (1 + 1e-9)
+    assert r.upper - r.lower <= 1e-9 * r.upper
+    # the grid alone was wrong here: its µ peak gives a "margin" above the true one
+    assert 1.0 / np.max(r.mu_upper) > bm * 1.05
+    # the worst value is checked with the matrix built with numbers
+    p = np.linalg.eigvals(A_MODES + r.worst["d"] * np.outer(B_COUPLE, C_COUPLE))
+    k = np.argmax(p.real)
+    assert abs(p[k].real) <= 1e-7 and abs(p[k].imag) == pytest.approx(r.critical_frequency, rel=1e-6)
+
+
+def test_robstab_docstring_example_is_exact():
+    """x'' + c x' + x, c = 1 + 2δ: a pole pair at ±j exactly when c = 0, δ = -1/2."""
+    c = ureal("c", 1.0, plusminus=2.0)
+    r = robstab(uss([[0, 1], [-1, -c]], [[0], [1]], [[1, 0]], [[0]]))
+    assert r.method == "exact" and r.checked
+    assert r.lower <= 0.5 <= r.upper * (1 + 1e-12)
+    assert r.upper - r.lower <= 1e-9
+    assert r.worst["c"] == pytest.approx(0.0, abs=1e-8)
+    assert r.critical_frequency == pytest.approx(1.0, rel=1e-6)
+
+
+def test_robstab_no_crossing_is_an_infinite_exact_margin():
+    """x' = -(a² + 1) x: the pole is below -1 for every real a (a repeated twice)."""
+    a = ureal("a", 2.0, plusminus=1.0)
+    r = robstab(uss([[-a * a - 1]], [[1]], [[1]], [[0]]))  # -(a² + 1) < 0 for every real a
+    assert r.method == "exact" and r.lower == np.inf and r.upper == np.inf
+
+
+def test_robstab_grid_contradiction_is_never_returned():
+    """Two parameters (the exact route does not apply); the output gain g cannot change
+    stability, so the margin is the single-parameter one and the grid, as above, reads a
+    µ peak below the checked perturbation: it must be refined or withdrawn, and said."""
+    G = coupled_modes(ureal("g", 1.0, plusminus=0.1))
+    r = robstab(G)
+    bm = coupled_modes_brute_margin()
+    assert r.method == "grid" and r.checked
+    assert r.lower <= r.upper and r.lower <= bm * (1 + 1e-9)
+    assert r.upper == pytest.approx(bm, rel=1e-6)
+    assert r.warnings and "exceeded the checked perturbation" in r.warnings[0]
+
+
 # ---------------------------------------------------------------- brute force (slow)
 @pytest.mark.slow
 @pytest.mark.parametrize("name", list(PLANTS))
@@ -215,6 +308,7 @@ def test_robstab_against_brute_force(name):
     unc, direct, spec = PLANTS[name]
     G = unc()
     r = robstab(G)
+    assert r.lower <= r.upper
     bm = brute_margin(direct, spec, points=41 if len(spec) < 3 else 21)
     # the grid's margin is an upper bound of the true one, within the grid's resolution
     assert r.lower <= bm * (1 + 1e-6)
