@@ -1,4 +1,5 @@
-"""LMI vs Riccati (python-control) vs dkpy H∞ synthesis: wall time and certified γ.
+"""LMI (controller SDP, or explicit formulas: ``lmi_explicit``) vs Riccati (python-control)
+vs dkpy H∞ synthesis: wall time and certified γ.
 
 Run: ``python -m pytest benchmarks/bench_hinfsyn.py --benchmark-only -p no:cacheprovider``.
 Each case runs once (pedantic, one round): the solves take seconds.  Every controller,
@@ -12,7 +13,7 @@ import pytest
 
 from lmi_suspension.errors import LmiSuspensionError
 from lmi_suspension.lti import hinfnorm, lft
-from lmi_suspension.synthesis import hinfsyn
+from lmi_suspension.synthesis import HinfsynOptions, hinfsyn
 from lmi_suspension.synthesis.examples import random_plant
 
 ORDERS = [4, 8, 16, 22, 30, 40]
@@ -36,7 +37,7 @@ def _run_dkpy(P):
     return K, float(gam)
 
 
-@pytest.mark.parametrize("method", ["lmi", "riccati", "dkpy"])
+@pytest.mark.parametrize("method", ["lmi", "lmi_explicit", "riccati", "dkpy"])
 @pytest.mark.parametrize("n", ORDERS)
 def test_hinfsyn(benchmark, n, method):
     P = plant(n)
@@ -46,6 +47,9 @@ def test_hinfsyn(benchmark, n, method):
         try:
             if method == "dkpy":
                 return _run_dkpy(P)
+            if method == "lmi_explicit":  # the controller by explicit formulas
+                return hinfsyn(P, P.ny, P.nu, method="lmi",
+                               options=HinfsynOptions(controller="explicit"))
             return hinfsyn(P, P.ny, P.nu, method=method)
         except (LmiSuspensionError, ValueError, np.linalg.LinAlgError) as exc:
             # record failures instead of aborting the run
@@ -63,5 +67,6 @@ def test_hinfsyn(benchmark, n, method):
     benchmark.extra_info.update(
         gamma=res.gamma, gamma_solver=res.gamma_solver, gamma_lower=res.gamma_lower,
         fastest_controller_pole=res.controller_fastest_pole, warnings=len(res.warnings),
+        status=res.status,
         timings=dict(setup=res.timings.setup, solve=res.timings.solve,
                      reconstruct=res.timings.reconstruct, certify=res.timings.certify))

@@ -49,6 +49,12 @@ _NARROW_SIGMA_CAP = 100.0
 #: took 13 s in failed full-frame solves before the capped frame certified (measured
 #: 2026-11-25); COMPleib's frames span at most 2e4
 _WIDE_SIGMA = 1e6
+#: ``controller="explicit"``: the explicit controller is kept only where its fastest pole
+#: is within this multiple of ``max(1, fastest plant mode)`` rad/s.  It has no trace box:
+#: on the regular plants of ``bench_hinfsyn.py`` (n = 4-40) its poles were 0.9-43 times
+#: the SDP controller's and all within the cap; on 11 of 12 COMPleib plants (mostly
+#: D21 = 0) 20-1e5 times, 1e5-3e8 rad/s, all outside it (measured 2026-11-27)
+_EXPLICIT_POLE_CAP = 1e4
 #: recoveries inside one controller LMI solve (the outer ladder handles the rest): the
 #: three-decade D-scaled distillation plant needed two under one OpenBLAS kernel, and
 #: a third and fourth only cost time (measured 2026-11-25)
@@ -404,6 +410,10 @@ def _reconstruct(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling,
     if n and np.ptp(np.log10(_lmi.Frame.from_lyapunov(sols[0].R, sols[0].S).sigma)) > \
             np.log10(_WIDE_SIGMA):
         frames[:2] = frames[1::-1]
+    if opts.controller == "explicit" and n:
+        found = _explicit(G, Ps, sc, sols[0], g_base, fixed, opts, warnings)
+        if found is not None:
+            return found
     lmis: dict = {}
     # the outer ladder handles a failed solve: one recovery inside it is enough
     inner = replace(opts, max_recoveries=min(int(opts.max_recoveries), _INNER_RECOVERIES))
@@ -448,6 +458,49 @@ def _reconstruct(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling,
         raise last
     raise SolverError(f"controller reconstruction failed after {opts.max_recoveries} "
                       f"recoveries: {last}")
+
+
+def _explicit(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling, sol,
+              g_base: float, fixed: bool, opts: HinfsynOptions, warnings: list):
+    """The explicit controller (:func:`~.lmi.decoupled_controller`) at ``(1 + r) g_base``
+    with ``r = gamma_relax`` (0 at a fixed γ), as :func:`_reconstruct` returns it; None
+    (and a warning) where it fails, is not certified at its level, or is faster than
+    ``_EXPLICIT_POLE_CAP`` allows.
+
+    ``(R, S)`` of the γ step are scaled by ``c = sqrt(1 + r)``: if they satisfy the two
+    projected bounded-real inequalities at ``g``, ``(cR, cS)`` satisfy them at
+    ``(1 + r) g`` for every ``c`` in ``[1/(1 + r), 1 + r]`` (``c`` times the old
+    inequality, congruent, plus a negative semidefinite term), and the coupling gains
+    ``(c - 1/c) S⁻¹``: slack on both sides.  Unscaled, the γ-optimal pair violated the
+    coupling by 1.5e-7 on COMPleib NN2 (measured 2026-11-27).
+    """
+    r = 0.0 if fixed else float(opts.gamma_relax)
+    g_ctrl = g_base * (1.0 + r)
+    level = g_ctrl / sc.gamma_factor
+    c = float(np.sqrt(1.0 + r))
+    try:
+        Ks, cond_xy = _lmi.decoupled_controller(Ps, c * sol.R, c * sol.S, g_ctrl)
+        K = _undo_loop_shift(sc.controller_to_original(Ks), G.D22)
+    except (SolverError, np.linalg.LinAlgError) as exc:
+        warnings.append(f"explicit controller at gamma={level:.6g} failed ({exc}); "
+                        "the controller LMI instead")
+        return None
+    tc = time.perf_counter()
+    cert_warn: list[str] = []
+    CL, gamma, poles = _certify(G, K, level, opts, cert_warn, "lmi")
+    t_cert = time.perf_counter() - tc
+    fastest = _fastest_pole(K)
+    plant_fastest = float(np.max(np.abs(np.linalg.eigvals(G.A)))) if G.nstates else 0.0
+    cap = _EXPLICIT_POLE_CAP * max(1.0, plant_fastest)
+    if not np.isfinite(gamma) or cert_warn:
+        why = "; ".join(cert_warn) or "not certified"
+    elif fastest > cap:
+        why = f"its fastest pole {fastest:.3g} rad/s is beyond {cap:.3g}"
+    else:
+        return K, CL, gamma, poles, level, "explicit", cond_xy, t_cert
+    warnings.append(f"explicit controller at gamma={level:.6g}: {why}; the controller "
+                    "LMI instead")
+    return None
 
 
 def _unit_gamma(Ps: GeneralizedPlant, sc: PlantScaling, g: float, sols: list):
