@@ -285,7 +285,49 @@ def test_robstab_no_crossing_is_an_infinite_exact_margin():
     """x' = -(a² + 1) x: the pole is below -1 for every real a (a repeated twice)."""
     a = ureal("a", 2.0, plusminus=1.0)
     r = robstab(uss([[-a * a - 1]], [[1]], [[1]], [[0]]))  # -(a² + 1) < 0 for every real a
-    assert r.method == "exact" and r.lower == np.inf and r.upper == np.inf
+    # (rounding-error roots far out are not examined: "at least 1000 times the range")
+    assert r.method == "exact" and r.lower >= 1000.0 and r.upper == np.inf
+
+
+def _second_order(k, c):
+    """x'' + c x' + k x = u, y = x (Routh-Hurwitz: stable iff c > 0 and k > 0)."""
+    return uss([[0, 1], [-k, -c]], [[0], [1]], [[1, 0]], [[0]])
+
+
+@pytest.mark.parametrize("build, margin, bracket", [
+    # k = 1 + 3δ reaches 0 at δ = -1/3 (a real pole crosses at s = 0); c stays positive:
+    # one side crosses, the other only has rounding-error roots
+    (lambda d: _second_order(1 + 3 * d, 1 + d * d), 1 / 3, 1e-12),
+    (lambda d: _second_order(1 + 3 * d, (2 * d - 1) * (2 * d - 1) + 0.1), 1 / 3, 1e-12),
+    # c = (2δ - 1)² touches 0 at δ = 1/2 without changing sign: a pole pair touches ±j
+    (lambda d: _second_order(1, (2 * d - 1) * (2 * d - 1)), 0.5, 1e-6),
+])
+def test_robstab_exact_on_one_sided_and_touching_crossings(build, margin, bracket):
+    """Routh-Hurwitz gives each margin; the exact route must take them (it examined
+    rounding-error roots far out on the side without a crossing and gave up, found in
+    review 2026-11-27)."""
+    r = robstab(build(ureal("d", 0.0, plusminus=1.0)))
+    assert r.method == "exact" and not r.warnings
+    assert r.lower <= margin * (1 + 1e-8) and margin * (1 - 1e-8) <= r.upper
+    assert r.upper - r.lower <= bracket * r.upper * 1.01
+
+
+def test_robstab_no_crossing_within_the_examined_range():
+    """c = (2δ - 1)² + 1e-3 > 0 for every real δ: no crossing; roots beyond 1000 times
+    the range are not examined (rounding alone makes the loop look unstable there), so
+    the margin is reported as at least 1000."""
+    d = ureal("d", 0.0, plusminus=1.0)
+    r = robstab(_second_order(1, (2 * d - 1) * (2 * d - 1) + 1e-3))
+    assert r.method == "exact" and r.lower == 1000.0 and r.upper == np.inf
+
+
+def test_robstab_static_loop_loses_well_posedness():
+    """y = 2 u / (1 - 2 δ)-type static loop: ill posed at |δ| = 1/2 (no states, so the
+    grid route; it read 0.5 against a checked 0.49999999995, which must not be returned
+    as lower > upper)."""
+    r = robstab(feedback(uss(control.ss([], [], [], [[2.0]])), ureal("d", 0.0, plusminus=1.0)))
+    assert r.lower <= r.upper
+    assert r.lower == pytest.approx(0.5, rel=1e-8) and r.upper == pytest.approx(0.5, rel=1e-8)
 
 
 def test_robstab_grid_contradiction_is_never_returned():

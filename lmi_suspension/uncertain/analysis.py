@@ -318,6 +318,18 @@ _AXIS_RTOL = 1e-8
 #: points per side of the independent sweep of the closed loop's spectral abscissa over
 #: ``[-α, α]`` that confirms the interval the roots say is stable (0.01 s at n = 14).
 _SWEEP_POINTS = 200
+#: roots of larger ``|δ|`` are not examined: they include rounding-error roots (1e7-1e15
+#: on one-sided problems), and where ``δ`` enters quadratically the loop evaluated there
+#: looks unstable from rounding alone (``c = (2δ - 1)² + 1e-3`` at ``δ = -1e6``: a pole
+#: of -2.5e-13 computed beside one of -4e12); a margin beyond it is reported as at least
+#: this, not as infinite
+_EXACT_MAX_DELTA = 1e3
+#: the independent sweep covers ``[-min(lower, _SWEEP_MAX), min(lower, _SWEEP_MAX)]``: the
+#: normalised range and ten times beyond it, where a user reads a margin
+_SWEEP_MAX = 10.0
+#: roots closer than this (relative) are one root: a double root at a crossing is
+#: computed as two a few 1e-9 apart, and the midpoint between them says nothing
+_ROOT_MERGE_RTOL = 1e-6
 
 
 class _ExactFailed(Exception):
@@ -376,50 +388,71 @@ def _exact_single_real(x: USS, clo: _Closure):
 
     Returns ``(lower, upper, δ_worst, ω_c)``: the closed loop is stable for every
     ``|δ| <= lower`` and has a pole on or right of the imaginary axis (or is ill posed) at
-    ``δ_worst``, ``|δ_worst| = upper``, ``upper − lower <= 1e-12 upper`` (bisection), or
-    ``(inf, inf, None, nan)`` if no real ``δ`` destabilises it.  Exact because every ``δ``
-    at which a pole reaches the axis is a root found by :func:`_single_real_roots`, the
-    poles are continuous in ``δ`` while the loop is well posed, and the nominal is stable:
-    on each side the first verified root is the crossing.  Raises :class:`_ExactFailed`
-    when the verification contradicts this (a root missed numerically).
+    ``δ_worst``, ``|δ_worst| = upper``.  A crossing is bisected to
+    ``upper − lower <= 1e-12 upper``; a pole that touches the axis without crossing it
+    (``|Re λ| <= _AXIS_RTOL``, relative) is reported at its root, ``lower`` then
+    ``_BRACKET`` (relative) below it.  ``(inf, inf, None, nan)`` if no real ``δ``
+    destabilises the loop; ``(_EXACT_MAX_DELTA, inf, None, nan)`` if none does up to that
+    size and roots beyond it were not examined.
+
+    Exact because every ``δ`` at which a pole reaches the axis is a root found by
+    :func:`_single_real_roots`, the poles are continuous in ``δ`` while the loop is well
+    posed, and the nominal is stable: on each side the roots are examined in order, each
+    between the midpoints to its neighbours (a computed root off by more than the bracket
+    is still caught: the loop is stable at the lower midpoint and unstable at the upper
+    one, and the crossing is bisected between them).  Raises :class:`_ExactFailed` when
+    the verification contradicts this (a root missed numerically).
     """
     A, Bw, _, Cz, _, Dzw, *_ = x.partition()
     cands = _single_real_roots(A, Bw, Cz, Dzw)
+    beyond = bool(np.any(np.abs(cands) > _EXACT_MAX_DELTA))
+    cands = cands[np.abs(cands) <= _EXACT_MAX_DELTA]
     found = {}
+    limit = _EXACT_MAX_DELTA  # nothing beyond a crossing already found needs examining
+
+    def stable(d):
+        return _abscissa_1(clo, d)[0] < 0
+
     for s in (1.0, -1.0):
-        for dc in cands[np.sign(cands) == s]:
-            a_in, _, _ = _abscissa_1(clo, dc * (1 - _BRACKET))
-            if not a_in < 0:
-                raise _ExactFailed(f"unstable at δ = {dc * (1 - _BRACKET):.6g}, inside the first candidate")
-            a_out, _, _ = _abscissa_1(clo, dc * (1 + _BRACKET))
-            if a_out >= 0:  # crosses in the bracket: bisect to a stable and an unstable point
-                lo, hi = abs(dc) * (1 - _BRACKET), abs(dc) * (1 + _BRACKET)
+        mags = np.unique(np.abs(cands[np.sign(cands) == s]))
+        mags = mags[mags <= limit]
+        if mags.size:
+            keep = np.concatenate([[True], np.diff(mags) > _ROOT_MERGE_RTOL * mags[1:]])
+            mags = mags[keep]
+        lo = 0.5 * mags[0] if mags.size else 0.0
+        if mags.size and not stable(s * lo):
+            raise _ExactFailed(f"unstable at δ = {s * lo:.6g}, below the first root")
+        for k, m in enumerate(mags):
+            hi = 0.5 * (m + mags[k + 1]) if k + 1 < mags.size else min(2.0 * m, _EXACT_MAX_DELTA)
+            if not stable(s * hi):  # a crossing in (lo, hi): bisect it
                 while hi - lo > _BISECT_RTOL * hi:
                     mid = 0.5 * (lo + hi)
-                    if _abscissa_1(clo, s * mid)[0] >= 0:
-                        hi = mid
-                    else:
+                    if stable(s * mid):
                         lo = mid
+                    else:
+                        hi = mid
                 found[s] = (lo, hi)
                 break
-            a_c, _, rho = _abscissa_1(clo, dc)
+            a_c, _, rho = _abscissa_1(clo, s * m)
             if a_c >= -_AXIS_RTOL * max(1.0, rho):  # touches the axis without crossing
-                found[s] = (abs(dc) * (1 - _BRACKET), abs(dc))
+                found[s] = (m * (1 - _BRACKET), m)
                 break
-            # a spurious root (λ_i = −λ_j off the axis): not a crossing
+            lo = hi  # a spurious root (λ_i = −λ_j off the axis): not a crossing
+        if s in found:
+            limit = min(limit, found[s][1])
     if not found:
-        lower, upper, dworst, wc = np.inf, np.inf, None, np.nan
+        lower, upper, dworst, wc = (_EXACT_MAX_DELTA if beyond else np.inf), np.inf, None, np.nan
     else:
         s = min(found, key=lambda t: found[t][1])
         lower, upper = (float(v) for v in found[s])
         dworst = s * upper
-        a, wc, _ = _abscissa_1(clo, dworst)
-        if not a >= -_AXIS_RTOL * max(1.0, _abscissa_1(clo, dworst)[2]):
+        a, wc, rho = _abscissa_1(clo, dworst)
+        if not a >= -_AXIS_RTOL * max(1.0, rho):
             raise _ExactFailed(f"no pole on the axis at the reported δ = {dworst:.6g}")
         if not np.isfinite(wc):
             wc = np.inf  # loss of well-posedness: a pole at infinity
     # independent check of the interval the roots call stable: a sweep of the abscissa
-    span = min(lower, 1e6) if np.isfinite(lower) else 1e6
+    span = min(lower, _SWEEP_MAX)
     t = np.linspace(-span, span, 2 * _SWEEP_POINTS + 1)
     ab, _ = clo.abscissa(t[:, None])
     if np.any(ab >= 0):
@@ -441,7 +474,9 @@ class RobstabResult:
     lower, upper : float
         ``lower <= α <= upper``, never ``lower > upper``.  With ``method == "exact"``
         (one real parameter, see :func:`robstab`) both are the exact margin, bracketed by
-        bisection to ``upper - lower <= 1e-12 upper``.  Otherwise ``lower = 1 / max_ω
+        bisection to ``upper - lower <= 1e-12 upper`` (to ``1e-6 upper`` where a pole
+        touches the axis without crossing it); ``lower = 1000, upper = inf`` says that
+        no value up to 1000 times the range destabilises the loop.  Otherwise ``lower = 1 / max_ω
         µ_upper`` (grid-certified) and ``upper`` the size of the checked destabilising
         perturbation (``inf`` if none was found); if the grid bound contradicts the
         checked perturbation even after refinement, ``lower`` is 0 (see ``warnings``).
@@ -636,7 +671,7 @@ def robstab(usys, omega=None, *, rng: np.random.Generator | None = None) -> Robs
 
     notes = []
     if (clo is not None and len(x.blocks) == 1 and isinstance(x.blocks[0].atom, UReal)
-            and x.nstates <= _EXACT_MAX_STATES):
+            and 0 < x.nstates <= _EXACT_MAX_STATES):
         # one real parameter: µ is zero between crossing frequencies and the grid can step
         # over a crossing (lower above the true margin), so solve the crossing conditions
         try:
@@ -645,13 +680,13 @@ def robstab(usys, omega=None, *, rng: np.random.Generator | None = None) -> Robs
                 # the ray search's checked instability inside the interval called stable
                 raise _ExactFailed(f"the ray search is unstable at α = {best[0]:.6g} < {lo_e:.6g}")
             if dw is None:
-                return RobstabResult(np.inf, np.inf, np.nan, MappingProxyType({}), MappingProxyType({}),
+                return RobstabResult(lo_e, np.inf, np.nan, MappingProxyType({}), MappingProxyType({}),
                                      False, w_all, mu_up, res, time.perf_counter() - t0, "exact")
             name = x.blocks[0].atom.name
             return RobstabResult(lo_e, up_e, float(wce), MappingProxyType(_values(x.blocks, [dw])),
                                  MappingProxyType({name: dw}), _check_worst(x, clo, [dw], wce), w_all,
                                  mu_up, res, time.perf_counter() - t0, "exact")
-        except _ExactFailed as e:
+        except (_ExactFailed, ValueError, np.linalg.LinAlgError) as e:
             notes.append(f"exact single-parameter route not certified ({e}); grid bounds reported")
             logger.warning("robstab: %s", notes[-1])
 
@@ -664,6 +699,8 @@ def robstab(usys, omega=None, *, rng: np.random.Generator | None = None) -> Robs
     worst = _values(x.blocks, dvals)
     norm = {b.atom.name: v for b, v in zip(x.blocks, dvals)}
     upper = float(alpha)
+    if upper < lower <= upper * (1 + _AGREE_RTOL):
+        lower = upper  # the two agree to roundoff (a pole at the origin: both exact)
     if lower > upper and checked:
         # the grid stepped over the crossing: re-evaluate around it with the real blocks
         # regularised (continuous in ω), and report no grid value the perturbation refutes
@@ -684,10 +721,20 @@ def robstab(usys, omega=None, *, rng: np.random.Generator | None = None) -> Robs
             notes.append(f"the grid bound {grid_lower:.6g} exceeded the checked perturbation "
                          f"{upper:.6g}; replaced by the bound regularised around ω = {wc:.6g}")
         logger.warning("robstab: %s", notes[-1])
+    elif lower > upper:
+        # a perturbation that did not check is no bound: the grid's is kept, and said
+        notes.append(f"the perturbation of size {upper:.6g} did not check (no pole on the "
+                     f"axis) and the grid bound {lower:.6g} is above it: no upper bound reported")
+        logger.warning("robstab: %s", notes[-1])
+        upper = np.inf
     return RobstabResult(lower, upper, float(wc), MappingProxyType(worst), MappingProxyType(norm),
                          checked, w_all, mu_up, res, time.perf_counter() - t0, "grid", tuple(notes))
 
 
+#: grid and checked perturbation closer than this (relative) agree: both are computed
+#: to about 1e-10 (a loss of well-posedness of a static loop gave 0.5 against
+#: 0.49999999995, 2026-11-27)
+_AGREE_RTOL = 1e-8
 #: size of the complex disc added to each real parameter by :func:`_regularised_peak`: the
 #: bound over-estimates real µ by at most the factor ``1 + ε`` at a crossing and its spike
 #: there widens in proportion to ``ε`` (Packard & Pandey 1993).
