@@ -294,21 +294,23 @@ def _second_order(k, c):
     return uss([[0, 1], [-k, -c]], [[0], [1]], [[1, 0]], [[0]])
 
 
-@pytest.mark.parametrize("build, margin, bracket", [
+@pytest.mark.parametrize("build, margin, bracket, rtol", [
     # k = 1 + 3δ reaches 0 at δ = -1/3 (a real pole crosses at s = 0); c stays positive:
     # one side crosses, the other only has rounding-error roots
-    (lambda d: _second_order(1 + 3 * d, 1 + d * d), 1 / 3, 1e-12),
-    (lambda d: _second_order(1 + 3 * d, (2 * d - 1) * (2 * d - 1) + 0.1), 1 / 3, 1e-12),
-    # c = (2δ - 1)² touches 0 at δ = 1/2 without changing sign: a pole pair touches ±j
-    (lambda d: _second_order(1, (2 * d - 1) * (2 * d - 1)), 0.5, 1e-6),
+    (lambda d: _second_order(1 + 3 * d, 1 + d * d), 1 / 3, 1e-12, 1e-8),
+    (lambda d: _second_order(1 + 3 * d, (2 * d - 1) * (2 * d - 1) + 0.1), 1 / 3, 1e-12, 1e-8),
+    # c = (2δ - 1)² touches 0 at δ = 1/2 without changing sign: a pole pair touches ±j.
+    # A double root is computed to about sqrt(eps): 5.8e-9 (Haswell) and 1.2e-8
+    # (Nehalem) below 1/2, measured 2026-11-27, hence rtol 1e-7 there
+    (lambda d: _second_order(1, (2 * d - 1) * (2 * d - 1)), 0.5, 1e-6, 1e-7),
 ])
-def test_robstab_exact_on_one_sided_and_touching_crossings(build, margin, bracket):
+def test_robstab_exact_on_one_sided_and_touching_crossings(build, margin, bracket, rtol):
     """Routh-Hurwitz gives each margin; the exact route must take them (it examined
     rounding-error roots far out on the side without a crossing and gave up, found in
     review 2026-11-27)."""
     r = robstab(build(ureal("d", 0.0, plusminus=1.0)))
     assert r.method == "exact" and not r.warnings
-    assert r.lower <= margin * (1 + 1e-8) and margin * (1 - 1e-8) <= r.upper
+    assert r.lower <= margin * (1 + rtol) and margin * (1 - rtol) <= r.upper
     assert r.upper - r.lower <= bracket * r.upper * 1.01
 
 
