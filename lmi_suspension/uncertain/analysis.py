@@ -307,9 +307,9 @@ _EXACT_MAX_STATES = 40
 #: ``A ⊕ A``), computed with an imaginary part of order sqrt(eps) |μ|; a spurious
 #: candidate let through costs one eigenvalue check and is rejected there.
 _REAL_RTOL = 1e-5
-#: relative bracket around a candidate crossing: the closed loop must be stable at
-#: ``(1 - _BRACKET) δ`` (else a crossing was missed and the route gives up) and is
-#: bisected to ``_BISECT_RTOL`` between a stable and an unstable point.
+#: a pole touching the axis without crossing it is reported at its root, ``lower`` this
+#: much (relative) below it; a crossing is bisected to ``_BISECT_RTOL`` between a stable
+#: and an unstable point.
 _BRACKET = 1e-6
 _BISECT_RTOL = 1e-12
 #: relative tolerance of a pole touching the axis without crossing it (a tangency):
