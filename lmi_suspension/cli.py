@@ -344,12 +344,13 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         axes.append((name.strip(), value.strip()))
     axes = [(n, v) for n, v in axes if v is not None]
     if args.spec is not None:
-        if axes or args.controller or args.samples:
-            raise ParameterError("--spec: give the axes and controllers in the spec file, "
-                                 "not also as flags")
+        if axes or args.controller or args.samples or args.sampling:
+            raise ParameterError("--spec: give the axes, controllers, samples and sampling "
+                                 "in the spec file, not also as flags")
         spec = SweepSpec.from_toml(args.spec)
     else:
         controllers = tuple(args.controller or ("passive",))
+        sampling = args.sampling or "uniform"
         if args.samples:
             ranges = []
             for name, value in axes:
@@ -360,11 +361,12 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                 ranges.append((name, *parse_range([lo, hi], name)))
             spec = SweepSpec(controllers=controllers, samples=args.samples,
                              ranges=tuple(ranges), road=args.road, duration=args.duration,
-                             seed=args.seed, limit=not args.no_limit)
+                             seed=args.seed, limit=not args.no_limit, sampling=sampling)
         else:
             grid = tuple((n, parse_range(v, n)) for n, v in axes)
             spec = SweepSpec(controllers=controllers, grid=grid, road=args.road,
-                             duration=args.duration, seed=args.seed, limit=not args.no_limit)
+                             duration=args.duration, seed=args.seed, limit=not args.no_limit,
+                             sampling=sampling)
     bar = _progress_bar(args, spec.n_cases, "cases")
     try:
         res = run_sweep(spec, args.out, scheduler=args.scheduler, workers=args.workers,
@@ -481,6 +483,10 @@ def build_parser() -> argparse.ArgumentParser:
                       help="record length, s (bump 3, others 5)")
     p_sw.add_argument("--samples", type=int, default=0,
                       help="Monte-Carlo: this many cases per controller, axes as lo:hi")
+    p_sw.add_argument("--sampling", choices=("uniform", "lhs"), default=None,
+                      help="with --samples: draw each case uniformly (default), or 'lhs': "
+                           "one Latin hypercube of the samples, the same seats for every "
+                           "controller")
     p_sw.add_argument("--seed", type=int, default=0, help="entropy of every case's seed (0)")
     p_sw.add_argument("--no-limit", action="store_true",
                       help="skip the physical limit (bump LP) and limit_ratio")

@@ -143,6 +143,165 @@ def test_spec_round_trips_through_json_and_reads_toml(tmp_path, controller_file)
         SweepSpec.from_toml(tmp_path / "missing.toml")
 
 
+# ----------------------------------------------------------------- Latin hypercube
+
+LHS_RANGES = (("m3", 30.0, 70.0), ("k1", 2e4, 4e4), ("c2", 50.0, 300.0))
+
+
+def _strata(values, lo, hi, n):
+    """The stratum (0 … n-1) of each value among n equal-width strata of [lo, hi]."""
+    return sorted(min(int((v - lo) / (hi - lo) * n), n - 1) for v in values)
+
+
+def _range_values(cases):
+    return [tuple(c.values[name] for name, _, _ in LHS_RANGES) for c in cases]
+
+
+def test_lhs_puts_one_sample_in_each_equal_width_stratum_of_every_axis(controller_file):
+    n = 20
+    spec = SweepSpec(controllers=(str(controller_file), "passive"),
+                     grid=(("height", (0.05, 0.1)),), samples=n, ranges=LHS_RANGES,
+                     sampling="lhs", seed=5)
+    cases = spec.cases()
+    assert len(cases) == 2 * 2 * n
+    blocks = [cases[i:i + n] for i in range(0, len(cases), n)]
+    for block in blocks:
+        for name, lo, hi in LHS_RANGES:
+            values = [c.values[name] for c in block]
+            assert all(lo <= v <= hi for v in values)
+            assert _strata(values, lo, hi, n) == list(range(n)), name
+    # one hypercube shared by every controller and grid point: each meets the same seats
+    assert all(_range_values(b) == _range_values(blocks[0]) for b in blocks)
+    assert [c.values["height"] for c in cases[:n + 1]] == [0.05] * n + [0.1]
+    # the check discriminates: uniform draws of the same spec are not stratified
+    uniform = SweepSpec(samples=n, ranges=LHS_RANGES, seed=5).cases()
+    assert any(_strata([c.values[name] for c in uniform], lo, hi, n) != list(range(n))
+               for name, lo, hi in LHS_RANGES)
+
+
+def test_lhs_case_takes_its_row_of_the_documented_hypercube_delay_rounded():
+    from scipy.stats import qmc
+
+    ranges = (("delay", 0.0, 0.05), ("m3", 30.0, 70.0), ("k2", 5e4, 5e4))
+    spec = SweepSpec(controllers=("passive", "design"), samples=6, ranges=ranges,
+                     sampling="lhs", seed=9)
+    # independent route: the hypercube as the docstring gives it, scaled by hand
+    unit = qmc.LatinHypercube(d=3, seed=np.random.default_rng(
+        np.random.SeedSequence(9))).random(6)
+    for case in spec.cases():
+        row = unit[case.index % 6]
+        assert case.values["delay"] == round(0.05 * row[0] / SIM_STEP) * SIM_STEP
+        assert case.values["m3"] == pytest.approx(30.0 + 40.0 * row[1], rel=1e-15)
+        assert case.values["k2"] == 5e4  # an empty range is its value
+        assert list(case.values) == ["delay", "m3", "k2"]
+
+
+def test_lhs_is_reproducible_from_the_seed():
+    def values(seed):
+        spec = SweepSpec(samples=8, ranges=LHS_RANGES, sampling="lhs", seed=seed)
+        return _range_values(spec.cases())
+
+    assert values(3) == values(3)
+    other = values(4)
+    assert all(a != b for row, row4 in zip(values(3), other) for a, b in zip(row, row4))
+    assert sorted(values(3)) != sorted(other)
+
+
+def test_lhs_values_do_not_depend_on_the_controllers_the_grid_or_the_split(
+        tmp_path, controller_file):
+    alone = _range_values(SweepSpec(samples=5, ranges=LHS_RANGES, sampling="lhs",
+                                    seed=2).cases())
+    crossed = SweepSpec(controllers=(str(controller_file), "passive", "design"),
+                        grid=(("speed_kmh", (20.0, 30.0, 40.0)),), samples=5,
+                        ranges=LHS_RANGES, sampling="lhs", seed=2).cases()
+    assert _range_values(crossed) == alone * 9
+    # a sweep run one case per batch in shuffled order, and resumed, gives the rows of one
+    # batch run straight through; each row holds its case's values
+    spec = SweepSpec(samples=4, ranges=(("m3", 40.0, 70.0), ("delay", 0.0, 0.02)),
+                     sampling="lhs", seed=1, duration=0.3, limit=False)
+
+    class Stop(Exception):
+        pass
+
+    def stop(k):
+        if k == 2:
+            raise Stop
+
+    with pytest.raises(Stop):
+        run_sweep(spec, tmp_path / "a", workers=0, batch_size=1, shuffle_seed=4,
+                  on_batch=stop, figures=False)
+    res = run_sweep(spec, tmp_path / "a", workers=0, batch_size=1, shuffle_seed=5,
+                    figures=False)
+    assert (res.n_skipped, res.n_run) == (2, 2)
+    run_sweep(spec, tmp_path / "b", workers=0, batch_size=4, figures=False)
+    rows = _rows(tmp_path / "a")
+    assert rows == _rows(tmp_path / "b")
+    assert [(r["m3"], r["delay"]) for r in rows] == [(c.values["m3"], c.values["delay"])
+                                                      for c in spec.cases()]
+
+
+def test_sampling_round_trips_through_json_and_toml(tmp_path):
+    spec = SweepSpec(grid=(("m3", (40.0, 60.0)),), samples=3, ranges=LHS_RANGES[1:],
+                     sampling="lhs", seed=4)
+    text = spec.to_json()
+    assert json.loads(text)["sampling"] == "lhs"
+    assert SweepSpec.from_json(text) == spec
+    assert SweepSpec.from_json(text).cases() == spec.cases()
+    # a uniform spec writes the JSON of before the option (its output directories
+    # resume), and JSON without the key reads as uniform
+    uniform = SweepSpec(samples=3, ranges=LHS_RANGES, seed=4)
+    assert "sampling" not in json.loads(uniform.to_json())
+    old = json.loads(spec.to_json())
+    del old["sampling"]
+    assert SweepSpec.from_json(json.dumps(old)).sampling == "uniform"
+    assert SweepSpec.from_json(uniform.to_json()) == uniform
+    # TOML: the key sampling of the [monte_carlo] table
+    (tmp_path / "s.toml").write_text(
+        'seed = 4\n[grid]\nm3 = [40, 60]\n[monte_carlo]\nsamples = 3\nsampling = "lhs"\n'
+        "k1 = [20000, 40000]\nc2 = [50, 300]\n")
+    assert SweepSpec.from_toml(tmp_path / "s.toml") == spec
+    (tmp_path / "u.toml").write_text("[monte_carlo]\nsamples = 3\nk1 = [20000, 40000]\n")
+    assert SweepSpec.from_toml(tmp_path / "u.toml").sampling == "uniform"
+    (tmp_path / "bad.toml").write_text(
+        '[monte_carlo]\nsamples = 3\nsampling = "sobol"\nk1 = [20000, 40000]\n')
+    with pytest.raises(ParameterError, match="sampling: unknown sampling 'sobol'; choose one "
+                                             "of uniform, lhs"):
+        SweepSpec.from_toml(tmp_path / "bad.toml")
+
+
+@pytest.mark.parametrize("kw, match", [
+    (dict(sampling="sobol"), "sampling: unknown sampling 'sobol'; choose one of uniform, lhs"),
+    (dict(sampling="LHS"), "sampling: unknown sampling 'LHS'; choose one of uniform, lhs"),
+    (dict(sampling=1), "sampling: unknown sampling 1; choose one of uniform, lhs"),
+    (dict(sampling=None), "sampling: unknown sampling None"),
+    (dict(sampling="lhs", samples=0, ranges=()), "sampling: 'lhs' draws Monte-Carlo samples, "
+                                                 "but samples = 0")])
+def test_bad_sampling_is_a_typed_error_naming_the_values(kw, match):
+    base = dict(samples=3, ranges=LHS_RANGES)
+    base.update(kw)
+    with pytest.raises(ParameterError, match=match):
+        SweepSpec(**base)
+
+
+@pytest.mark.parametrize("explicit", [False, True])
+def test_uniform_sampling_is_unchanged(controller_file, explicit):
+    """Each case's draws recomputed the old way: its own spawned generator, one uniform
+    draw per range in order (the delay then rounded to the step)."""
+    ranges = (("m3", 30.0, 70.0), ("delay", 0.0, 0.05), ("k1", 2e4, 4e4))
+    spec = SweepSpec(controllers=(str(controller_file), "passive"),
+                     grid=(("height", (0.05, 0.1)),), samples=3, ranges=ranges, seed=13,
+                     **(dict(sampling="uniform") if explicit else {}))
+    assert spec.sampling == "uniform"
+    cases = spec.cases()
+    assert len(cases) == 12
+    for k, case in enumerate(cases):
+        rng = np.random.default_rng(np.random.SeedSequence(13, spawn_key=(k,)))
+        drawn = {name: rng.uniform(lo, hi) for name, lo, hi in ranges}
+        drawn["delay"] = round(drawn["delay"] / SIM_STEP) * SIM_STEP
+        assert case.values == {"height": (0.05, 0.1)[(k // 3) % 2], **drawn}
+        assert case.seed == (13, k)
+
+
 @pytest.mark.parametrize("content, match", [
     (None, "not found"), ("{not json", "is not a saved controller"),
     ('{"A": [[1.0]]}', "is not a saved controller")])
@@ -357,6 +516,39 @@ def test_cli_sweep_writes_table_and_figures(tmp_path, controller_file, capsys):
     (["--controller", "missing.json"], "controllers: file missing.json not found"),
     (["--samples", "3", "--m3", "30:50:4"], "m3: with --samples give a range lo:hi")])
 def test_cli_sweep_bad_input_is_one_line_exit_2(tmp_path, argv, match, capsys):
+    from lmi_suspension.cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["sweep", "--out", str(tmp_path / "o"), "--workers", "0"] + argv)
+    assert exc.value.code == 2
+    assert match in capsys.readouterr().err
+
+
+def test_cli_sweep_sampling_flag_reaches_the_spec(tmp_path, capsys):
+    from lmi_suspension.cli import main
+
+    argv = ["sweep", "--samples", "3", "--m3", "40:70", "--delay", "0:0.02", "--seed", "6",
+            "--duration", "0.3", "--no-limit", "--workers", "0", "-q"]
+    assert main(argv + ["--sampling", "lhs", "--out", str(tmp_path / "lhs")]) == 0
+    table, spec = read_results(tmp_path / "lhs")
+    expected = SweepSpec(samples=3, ranges=(("m3", 40.0, 70.0), ("delay", 0.0, 0.02)),
+                         seed=6, duration=0.3, limit=False, sampling="lhs")
+    assert spec == expected
+    assert json.loads((tmp_path / "lhs" / "spec.json").read_text())["sampling"] == "lhs"
+    assert [(r["m3"], r["delay"]) for r in table.to_pylist()] == [
+        (c.values["m3"], c.values["delay"]) for c in expected.cases()]
+    assert main(argv + ["--out", str(tmp_path / "u")]) == 0
+    assert read_results(tmp_path / "u")[1].sampling == "uniform"
+    capsys.readouterr()
+
+
+@pytest.mark.parametrize("argv, match", [
+    (["--samples", "3", "--m3", "40:70", "--sampling", "sobol"],
+     "--sampling: invalid choice: 'sobol'"),  # (argparse quotes the choices by version)
+    (["--m3", "40:70:3", "--sampling", "lhs"],
+     "sampling: 'lhs' draws Monte-Carlo samples, but samples = 0"),
+    (["--spec", "s.toml", "--sampling", "lhs"], "--spec: give the axes")])
+def test_cli_sweep_bad_sampling_is_one_line_exit_2(tmp_path, argv, match, capsys):
     from lmi_suspension.cli import main
 
     with pytest.raises(SystemExit) as exc:

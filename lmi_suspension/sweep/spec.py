@@ -13,6 +13,10 @@ Axes (names of a grid axis or of a Monte-Carlo range):
 * ``delay``: the actuator delay, s (rounded to the simulation step, 0.1 ms by default);
 * the road's parameters: ``height`` (m), ``length`` (m) and ``speed_kmh`` of the bump;
   ``speed_kmh`` of the ISO 8608 road; ``psd`` ((m/s)²/Hz) of the white floor velocity.
+
+Monte-Carlo values are drawn uniformly, each case from its own generator (``sampling =
+"uniform"``), or as one Latin hypercube shared by every controller and grid point
+(``sampling = "lhs"``); see :class:`SweepSpec`.
 """
 
 from __future__ import annotations
@@ -29,7 +33,8 @@ import numpy as np
 from ..errors import InputError, ParameterError
 from ..seat.params import SeatParameters
 
-__all__ = ["DESIGN", "PASSIVE", "PLANT_AXES", "ROADS", "Case", "SweepSpec", "parse_range"]
+__all__ = ["DESIGN", "PASSIVE", "PLANT_AXES", "ROADS", "SAMPLINGS", "Case", "SweepSpec",
+           "parse_range"]
 
 #: the seat's parameters a sweep may vary (the delay bounds of SeatParameters are the
 #: design's, not a case's: a case has one delay)
@@ -46,6 +51,9 @@ PASSIVE = "passive"
 #: (:func:`~lmi_suspension.seat.design.design_mu_controller` with the paper's weights and
 #: uncertainty, once per distinct seat of the sweep)
 DESIGN = "design"
+#: how the Monte-Carlo values are drawn: uniformly, each case from its own generator, or
+#: as one Latin hypercube (see SweepSpec)
+SAMPLINGS = ("uniform", "lhs")
 #: the default simulation step, s (the simulator's own default)
 SIM_STEP = 1e-4
 #: the default record lengths, s (the bump's tail lets the seat settle)
@@ -152,11 +160,32 @@ class SweepSpec:
         Axes of a full grid, outermost first.  Axes not named keep their default
         (Table 1, no delay, the road's defaults).
     samples : int
-        Monte-Carlo: this many cases per controller, each drawing every axis of
-        ``ranges`` uniformly from its own generator (0: no Monte-Carlo).  The grid, if
-        any, is then crossed with the samples.
+        Monte-Carlo: this many cases per controller and grid point, drawn as ``sampling``
+        says (0: no Monte-Carlo).  The grid, if any, is then crossed with the samples.
     ranges : tuple of (str, float, float)
         Monte-Carlo axes and their bounds.
+    sampling : {"uniform", "lhs"}
+        How the Monte-Carlo values are drawn.
+
+        * ``"uniform"`` (default): each case draws every axis of ``ranges``, in order,
+          uniformly from its own generator (:meth:`Case.rng`); every controller and grid
+          point meets other seats.
+        * ``"lhs"``: the ``samples`` points over the ``ranges`` axes form one Latin
+          hypercube, ``scipy.stats.qmc.LatinHypercube(d=len(ranges),
+          seed=default_rng(SeedSequence(seed)))``, scaled to the ranges
+          (``qmc.scale``; an axis with ``lo == hi`` is that value); the s-th sample of
+          every (controller, grid point) block takes row s.  So along each axis the
+          samples fall one in each of ``samples`` equal-width strata of the range.  The
+          hypercube is *shared* by every controller and grid point, rather than drawn per
+          block, so that each controller meets the same seats: the controllers'
+          differences are then not blurred by different draws (common random numbers),
+          and each block is itself a Latin hypercube.  It depends only on ``seed``,
+          ``samples`` and ``ranges``, never on how the cases are split, ordered or run,
+          and not on the controllers or the grid.  The values follow SciPy's algorithm,
+          so they may differ between SciPy versions (the table's metadata records them).
+          A ``delay`` is then rounded to the step as with ``"uniform"``, which moves it
+          by at most half a step (across a stratum's edge only when a stratum is
+          comparable to the step).  Needs ``samples`` > 0.
     road : {"bump", "iso8608", "noise"}
         The paper's bump (eq. 32), an ISO 8608 road, or white floor velocity.
     road_options : tuple of (str, object)
@@ -164,7 +193,8 @@ class SweepSpec:
     duration : float or None
         Length of the record, s (bump 3, others 5).
     seed : int
-        Entropy of every case's generator.
+        Entropy of every case's generator (and, with ``sampling="lhs"``, of the
+        hypercube).
     limit : bool
         Compute each case's physical limit (bump only: the clairvoyant LP of
         :func:`~lmi_suspension.seat.bump_limit`, once per distinct seat and bump) and the
@@ -184,6 +214,7 @@ class SweepSpec:
     seed: int = 0
     limit: bool = True
     step: float = SIM_STEP
+    sampling: str = "uniform"
 
     def __post_init__(self):
         if self.road not in ROADS:
@@ -209,6 +240,12 @@ class SweepSpec:
             raise ParameterError("ranges: Monte-Carlo ranges given but samples = 0")
         if self.samples and not self.ranges:
             raise ParameterError("samples: Monte-Carlo needs at least one range")
+        if not isinstance(self.sampling, str) or self.sampling not in SAMPLINGS:
+            raise ParameterError(f"sampling: unknown sampling {self.sampling!r}; choose one "
+                                 f"of {', '.join(SAMPLINGS)}")
+        if self.sampling != "uniform" and not self.samples:
+            raise ParameterError(f"sampling: {self.sampling!r} draws Monte-Carlo samples, "
+                                 f"but samples = 0")
         allowed = set(ROADS[self.road]) | set(_DEFAULT_ROAD[self.road])
         for name, _value in self.road_options:
             if name not in allowed:
@@ -269,17 +306,23 @@ class SweepSpec:
     def cases(self) -> list[Case]:
         """Every case, numbered: controller outermost, then the grid (outer axis first),
         then the Monte-Carlo sample.  Monte-Carlo values are drawn from the case's own
-        generator, so they do not depend on how the cases are split or ordered."""
+        generator (``"uniform"``) or are the sample's row of the spec's one Latin
+        hypercube (``"lhs"``), so they do not depend on how the cases are split or
+        ordered."""
         out = []
         names = [n for n, _ in self.grid]
         points = list(itertools.product(*[v for _, v in self.grid])) if self.grid else [()]
+        hypercube = self._latin_hypercube() if self.sampling == "lhs" else None
+        range_names = [n for n, _, _ in self.ranges]
         k = 0
         for ctrl in self.controllers:
             for point in points:
-                for _s in range(max(int(self.samples), 1)):
+                for s in range(max(int(self.samples), 1)):
                     values = dict(zip(names, point))
                     case = Case(k, str(ctrl), values, (int(self.seed), k))
-                    if self.ranges:
+                    if hypercube is not None:
+                        values.update(zip(range_names, (float(x) for x in hypercube[s])))
+                    elif self.ranges:
                         rng = case.rng()
                         for name, lo, hi in self.ranges:
                             values[name] = float(rng.uniform(lo, hi))
@@ -288,6 +331,23 @@ class SweepSpec:
                     out.append(case)
                     k += 1
         return out
+
+    def _latin_hypercube(self) -> np.ndarray:
+        """The ``samples`` × ``len(ranges)`` Latin hypercube of ``sampling="lhs"``, scaled to
+        the ranges (before the delay's rounding)."""
+        from scipy.stats import qmc
+
+        n = int(self.samples)
+        unit = qmc.LatinHypercube(
+            d=len(self.ranges),
+            seed=np.random.default_rng(np.random.SeedSequence(int(self.seed)))).random(n)
+        lo = np.array([r[1] for r in self.ranges], dtype=float)
+        hi = np.array([r[2] for r in self.ranges], dtype=float)
+        points = np.tile(lo, (n, 1))  # an axis with lo == hi is that value
+        wide = lo < hi  # (qmc.scale refuses empty ranges)
+        if wide.any():
+            points[:, wide] = qmc.scale(unit[:, wide], lo[wide], hi[wide])
+        return points
 
     def road_settings(self) -> dict:
         """The road's parameters with the fixed options applied (before the case's own),
@@ -301,8 +361,15 @@ class SweepSpec:
 
     # ------------------------------------------------------------------ I/O
     def to_json(self) -> str:
-        """A canonical JSON text (a resumed sweep must have the same one)."""
-        return json.dumps(asdict(self), sort_keys=True)
+        """A canonical JSON text (a resumed sweep must have the same one).
+
+        ``sampling`` is written only when it is not ``"uniform"``, so a uniform spec has the
+        text it had before the option existed, and its earlier output directories resume.
+        """
+        d = asdict(self)
+        if d["sampling"] == "uniform":
+            del d["sampling"]
+        return json.dumps(d, sort_keys=True)
 
     @classmethod
     def from_json(cls, text: str) -> SweepSpec:
@@ -313,7 +380,7 @@ class SweepSpec:
                    ranges=tuple((n, float(lo), float(hi)) for n, lo, hi in d["ranges"]),
                    road=d["road"], road_options=tuple((n, v) for n, v in d["road_options"]),
                    duration=d["duration"], seed=int(d["seed"]), limit=bool(d["limit"]),
-                   step=float(d.get("step", SIM_STEP)))
+                   step=float(d.get("step", SIM_STEP)), sampling=d.get("sampling", "uniform"))
 
     @classmethod
     def from_toml(cls, path) -> SweepSpec:
@@ -336,7 +403,8 @@ class SweepSpec:
 
             [monte_carlo]             # optional; crossed with the grid
             samples = 100
-            k1 = [24800, 37200]       # uniform ranges
+            sampling = "lhs"          # "uniform" (default) or "lhs": one Latin hypercube
+            k1 = [24800, 37200]       # ranges [lo, hi]
         """
         path = Path(path)
         try:
@@ -365,6 +433,7 @@ class SweepSpec:
                      for n, v in dict(data.get("grid", {})).items())
         mc = dict(data.get("monte_carlo", {}))
         samples = mc.pop("samples", 0)
+        sampling = mc.pop("sampling", "uniform")
         ranges = []
         for n, v in mc.items():
             if not (isinstance(v, (list, tuple)) and len(v) == 2):
@@ -374,5 +443,6 @@ class SweepSpec:
                    road=str(data.get("road", "bump")),
                    road_options=tuple(dict(data.get("road_options", {})).items()),
                    duration=data.get("duration"), seed=int(data.get("seed", 0)),
-                   limit=bool(data.get("limit", True)), step=data.get("step", SIM_STEP))
+                   limit=bool(data.get("limit", True)), step=data.get("step", SIM_STEP),
+                   sampling=sampling)
 
