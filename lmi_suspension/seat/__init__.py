@@ -4,7 +4,9 @@ model (Table 1, eq. 1) -> uncertainty and weights -> augmented plant of Fig. 2;
 roads -> exact-delay simulation -> comfort metrics; the physical limit of the bump.
 The designs: :mod:`.design` (µ-synthesis as in the paper), :mod:`.constrained` (hard
 force and stroke bounds in the K-step), :mod:`.refine` (the µ controller refined to the
-exact bump requirements) and :mod:`.sampled` (the 1 kHz implementation).
+exact bump requirements), :mod:`.multimodel` (that refinement over a set of seats, with
+a worst-case search) and :mod:`.sampled` (the 1 kHz implementation); :mod:`.occupants`
+is the set of seats a controller must serve and its certificate over them.
 """
 
 from .augmented import BUMP_PEAK_VELOCITY, SeatAugmentedPlant, SeatDesignOptions, seat_augmented_plant
@@ -20,8 +22,9 @@ from .simulate import (MonteCarloResult, SimulationMetrics, SimulationResult, cl
 from .limit import LimitResult, bump_limit
 from .bounded import PeakBoundedDesign, design_peak_bounded, road_energy
 # the designs' own modules, documented as modules: the µ design, its constrained K-step
-# route, the refinement, and the sampled-data implementation
-from . import constrained, design, refine, sampled
+# route, the refinement (on one seat and on a set), the set of seats and its certificate,
+# and the sampled-data implementation
+from . import constrained, design, multimodel, occupants, refine, sampled
 
 __all__ = [
     "SeatParameters", "SeatMatrices", "seat_matrices", "seat_model", "natural_modes",
@@ -35,5 +38,5 @@ __all__ = [
     "closed_loop_stable", "loop_transfer", "stability_delay_margin", "monte_carlo",
     "LimitResult", "bump_limit",
     "PeakBoundedDesign", "design_peak_bounded", "road_energy",
-    "design", "constrained", "refine", "sampled",
+    "design", "constrained", "refine", "multimodel", "occupants", "sampled",
 ]

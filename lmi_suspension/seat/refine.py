@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import control
@@ -225,8 +225,8 @@ class TwoBlockMu:
         Ak, Bk, Ck, Dk = (np.asarray(m, dtype=float) for m in (K.A, K.B, K.C, K.D))
         return np.linalg.eigvals(np.block([[A + B2 @ Dk @ C2, B2 @ Ck], [Bk @ C2, Ak]]))
 
-    def curve(self, K, omega=None) -> np.ndarray:
-        """µ at each grid frequency, or at ``omega`` (rad/s) where given."""
+    def _loop(self, K, omega=None) -> np.ndarray:
+        """The closed loop's response, shape ``(F, nz, nw)``, on the grid or at ``omega``."""
         from ..lti import freqresp
 
         c = self._c
@@ -238,7 +238,18 @@ class TwoBlockMu:
         Kw = frequency_response(K, 1j * omega)                  # (ny, F)
         loop = 1.0 - np.einsum("yf,yf->f", Kw, P22)
         KP21 = np.einsum("yf,ywf->wf", Kw, P21) / loop
-        M = np.moveaxis(P11 + P12[:, None, :] * KP21[None, :, :], -1, 0)
+        return np.moveaxis(P11 + P12[:, None, :] * KP21[None, :, :], -1, 0)
+
+    def cover_gain(self, K) -> np.ndarray:
+        """σ̄ of the first block's channel on the grid: µ of robust stability against
+        that block alone (one full complex block: µ is σ̄), the delay cover's."""
+        M = self._loop(K)[:, :self._c["rows"], :self._c["cols"]]
+        return np.linalg.svd(M, compute_uv=False)[:, 0]
+
+    def curve(self, K, omega=None) -> np.ndarray:
+        """µ at each grid frequency, or at ``omega`` (rad/s) where given."""
+        c = self._c
+        M = self._loop(K, omega)
         r, k = c["rows"], c["cols"]
 
         def scaled_norm(log_d):
@@ -433,6 +444,8 @@ _SHAPE_POLES = 4
 #: aims at every bound tightened by twice this fraction and counts an excess below it
 #: as met, so that what it returns is within the bounds themselves by about this much.
 _MARGIN = 3e-3
+#: step of the physical limit's LP for ``plants``, s (bump_limit's default; the sweep's)
+_LIMIT_DT = 2e-3
 
 
 #: µ's largest local maxima on the grid, refined between grid points
@@ -482,7 +495,16 @@ class RefineOptions:
     delays : tuple of float
         Delays the road requirements are evaluated at, s.
     max_iter : int
-        SLSQP iterations in all (every stage counts); about 0.65 s each on the seat.
+        SLSQP iterations in all (every stage counts); about 0.65 s each on the seat with
+        no further ``plants``, about that much more per plant.
+    plants : tuple of SeatParameters
+        Further seats the controller must serve (the multi-model tuning of MATLAB's
+        ``systune``): at each, the road requirements (``u_bound``, ``z_bound``, every
+        delay), the loop's stability and pole shape, and robust stability against the
+        delay cover (its gain below ``mu_max``) are required too.  With plants, the
+        objective is each seat's peak ``|z̈3|`` over *its own* physical limit
+        (:func:`~.limit.bump_limit` on the road), the worst over the design's seat and
+        the plants; without, the design seat's peak in m/s².
     """
 
     u_bound: float = 1500.0
@@ -491,6 +513,7 @@ class RefineOptions:
     disk_radius: float = 1900.0
     delays: tuple = REFINE_DELAYS
     max_iter: int = 600
+    plants: tuple = ()
 
     def __post_init__(self):
         for name in ("u_bound", "z_bound", "mu_max", "disk_radius"):
@@ -499,13 +522,18 @@ class RefineOptions:
                 raise ParameterError(f"{name} must be positive and finite, got {value!r}")
         if not (isinstance(self.max_iter, int) and self.max_iter >= 1):
             raise ParameterError(f"max_iter must be a positive int, got {self.max_iter!r}")
+        plants = tuple(self.plants)
+        for p in plants:
+            if not isinstance(p, SeatParameters):
+                raise ParameterError(f"plants must hold SeatParameters, got {type(p).__name__}")
+        object.__setattr__(self, "plants", plants)
 
 
 @dataclass(frozen=True)
 class _Point:
     """One controller's exact figures and how far it is from the requirements."""
 
-    z: np.ndarray           # peak |z3''| per delay
+    z: np.ndarray           # peak |z3''| per seat and delay (over the seat's limit)
     u: np.ndarray
     x1: np.ndarray
     mu_curve: np.ndarray    # µ on the search grid, at its refined peaks and resonances
@@ -531,11 +559,21 @@ class _Point:
         return self.objective < other.objective * (1 - 1e-6)
 
 
+@dataclass(frozen=True)
+class _Seat:
+    """One seat the requirements are evaluated at."""
+
+    bumpr: BumpResponse
+    unit: float                     # of its peak |z3''|: 1 (m/s²) or its own limit
+    params: SeatParameters | None
+    cover: TwoBlockMu | None        # its delay-cover gain (None: the design seat's µ)
+
+
 class _Problem:
     """The parametrisation (real modal form, normalised) and the exact evaluations."""
 
-    def __init__(self, K0: control.StateSpace, opts: RefineOptions, bumpr: BumpResponse,
-                 mu: TwoBlockMu, params):
+    def __init__(self, K0: control.StateSpace, opts: RefineOptions, seats: list,
+                 mu: TwoBlockMu):
         A = np.asarray(K0.A)
         self.n = A.shape[0]
         self.kinds, poles, i = [], [], 0
@@ -560,7 +598,7 @@ class _Problem:
                                 np.full(Dk.size, np.linalg.norm(Dk))]) * 0.1
         floor = np.maximum(floor, 1e-12)
         self.scale = np.concatenate([np.ones(self.npole), np.maximum(np.abs(gains), floor)])
-        self.opts, self.bumpr, self.mu, self.params = opts, bumpr, mu, params
+        self.opts, self.seats, self.mu = opts, seats, mu
         tight = 1.0 - 2 * _MARGIN
         self.bounds = dict(u=opts.u_bound * tight, x1=opts.z_bound * tight,
                            mu=opts.mu_max * tight, radius=opts.disk_radius * tight)
@@ -603,17 +641,22 @@ class _Problem:
         K = self.controller(y)
         with np.errstate(all="ignore"):
             try:
-                lp = loop_poles(K, self.params)
+                pa = self.mu.loop_poles(K)
+                poles = np.concatenate(
+                    [loop_poles(K, s.params) for s in self.seats] + [pa]
+                    + [s.cover.loop_poles(K) for s in self.seats if s.cover is not None])
             except np.linalg.LinAlgError:
                 return None
-            pa = self.mu.loop_poles(K)
-            poles = np.concatenate([lp, pa])
             if not np.all(np.isfinite(poles)) or np.max(poles.real) >= 0:
                 return None             # unstable: neither the FFT nor µ applies
-            z, u, x1 = self.bumpr.peaks(K)
+            peaks = [s.bumpr.peaks(K) for s in self.seats]
+            z = np.concatenate([zs / s.unit for (zs, _, _), s in zip(peaks, self.seats)])
+            u = np.concatenate([p[1] for p in peaks])
+            x1 = np.concatenate([p[2] for p in peaks])
             curve, top, _ = self.mu.peaks(K, _PEAKS)
-            mu = np.concatenate([curve, top,
-                                 self.mu.curve(K, _resonance_points(pa))])
+            mu = np.concatenate([curve, top, self.mu.curve(K, _resonance_points(pa))]
+                                + [s.cover.cover_gain(K) for s in self.seats
+                                   if s.cover is not None])
         b = self.bounds
         mags = np.sort(np.abs(np.concatenate([poles, np.linalg.eigvals(K.A)])))
         shape = _shape_margins(poles)
@@ -673,10 +716,12 @@ class RefinedDesign:
     K0 : control.StateSpace
         The start (the given controller, residualised to the disk).
     peak, u_peak, x1_peak : ndarray
-        Per delay of ``options.delays``: peak ``|z̈3|`` (m/s²), commanded ``|u|`` (N),
-        ``|x1|`` (m), linear loop on the road.
+        Per delay of ``options.delays``: peak ``|z̈3|`` (m/s²; with ``options.plants``
+        the worst over the seats of peak over own limit), commanded ``|u|`` (N),
+        ``|x1|`` (m), linear loop on the road (the worst over the seats).
     mu : float
-        µ peak on the search grid.
+        µ peak on the search grid (with ``options.plants``: or the largest delay-cover
+        gain at a plant, if larger).
     radius : float
         Largest controller or loop pole magnitude, rad/s.
     met : bool
@@ -700,6 +745,23 @@ class RefinedDesign:
     stages: tuple
     iterations: int
     seconds: float
+
+
+def _seats(opts: RefineOptions, design: SeatDesignOptions, params, road) -> list:
+    """The design seat, then ``opts.plants`` (with their own limits and delay covers)."""
+    from .limit import bump_limit
+
+    road = bump() if road is None else road
+    delays = tuple(opts.delays)
+    if not opts.plants:
+        return [_Seat(BumpResponse(road=road, delays=delays, params=params), 1.0, params,
+                      None)]
+    seats = []
+    for k, p in enumerate((params,) + opts.plants):
+        limit = bump_limit(road, p, dt=_LIMIT_DT).certified_peak
+        seats.append(_Seat(BumpResponse(road=road, delays=delays, params=p), float(limit),
+                           p, None if k == 0 else TwoBlockMu(design, _MU_GRID, p)))
+    return seats
 
 
 def refine_seat_controller(K0, options: RefineOptions | None = None, *,
@@ -755,10 +817,9 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
         if not np.all(np.isfinite(np.asarray(m, dtype=float))):
             raise ParameterError("K0 has non-finite entries")
     start = modal_form(K0, radius=opts.disk_radius)
-    prob = _Problem(start, opts, BumpResponse(road=road, delays=tuple(opts.delays),
-                                              params=params),
-                    TwoBlockMu(DEFAULT_DESIGN if design is None else design, _MU_GRID,
-                               params), params)
+    design = DEFAULT_DESIGN if design is None else design
+    prob = _Problem(start, opts, _seats(opts, design, params, road),
+                    TwoBlockMu(design, _MU_GRID, params))
     y = prob.x0 / prob.scale
     best = prob.evaluate(y)
     if best is None:
@@ -803,7 +864,9 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
             break        # SLSQP converged inside the box: a local optimum
     K = prob.controller(y)
     K = control.ss(K.A, K.B, K.C, K.D, inputs=["x1", "x3"], outputs=["u"], name="K_refined")
-    return RefinedDesign(K=K, K0=start, peak=best.z, u_peak=best.u, x1_peak=best.x1,
+    per_delay = (lambda v: np.max(v.reshape(len(prob.seats), -1), axis=0))
+    return RefinedDesign(K=K, K0=start, peak=per_delay(best.z), u_peak=per_delay(best.u),
+                         x1_peak=per_delay(best.x1),
                          mu=best.mu, radius=best.radius, met=best.violation <= _MARGIN,
                          options=opts, stages=tuple(stages), iterations=iterations,
                          seconds=time.perf_counter() - t_start)
@@ -918,6 +981,8 @@ def save_refined(path, d: RefinedDesign, *, dt: float = 1e-3) -> Path:
             "x1_peak": d.x1_peak.tolist(), "mu_search_grid": d.mu, "radius": d.radius,
             "met": d.met, "iterations": d.iterations, "design_seconds": d.seconds,
             "discretisation": f"Tustin, dt = {dt} s"}
+    if o.plants:
+        meta["plants"] = [asdict(p) for p in o.plants]
     return save_controller(path, d.K, inputs=["x1", "x3"], outputs=["u"], metadata=meta,
                            discrete=discretise_controller(d.K, dt))
 

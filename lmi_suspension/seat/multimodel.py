@@ -1,0 +1,182 @@
+"""One seat controller for a set of seats: the refinement over several plants, with a
+worst-case search that adds the seats it fails on (the multi-model tuning of MATLAB's
+``systune`` with uncertain parameters: tune on a finite set, search the continuum for a
+violation, add it, tune again).
+
+Each round refines the controller (:func:`~.refine.refine_seat_controller` with
+``RefineOptions.plants``) on the current seats: the road requirements (force, stroke,
+every delay), stability and robust stability against the delay cover hold at each, and
+the worst of each seat's peak ``|z̈3|`` over its own physical limit is minimised.  Then
+``n_search`` Latin-hypercube samples of the :class:`~.occupants.OccupantSet` are met by
+the result; the samples that violate a requirement, or whose ratio exceeds the rounds'
+worst over its seats, are added (at most ``add`` per round, the worst first), and the
+next round starts from the result.  The loop ends when a search finds nothing to add or
+after ``rounds`` rounds.
+
+The answer is certified by :func:`~.occupants.certify_occupants` on samples the search
+did not draw and by :func:`~.occupants.occupant_mu`.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import dataclass, replace
+from typing import Callable
+
+import control
+import numpy as np
+
+from ..errors import ParameterError
+from .occupants import _LIMIT_DT, OccupantSet
+from .refine import BumpResponse, RefinedDesign, RefineOptions, loop_poles, refine_seat_controller
+from .roads import RoadInput, bump
+
+__all__ = ["OccupantRound", "OccupantDesign", "refine_for_occupants"]
+
+logger = logging.getLogger(__name__)
+
+#: a search sample joins the seats when its ratio exceeds the round's worst by more than
+#: this fraction (below it, the FFT's and the search's own margins decide, not the seat)
+_ADD_TOL = 0.01
+
+
+@dataclass(frozen=True)
+class OccupantRound:
+    """One round of :func:`refine_for_occupants` (progress record).
+
+    Attributes
+    ----------
+    index : int
+    plants : tuple of SeatParameters
+        The seats the round refined on, besides the design seat.
+    design : RefinedDesign
+    worst_found : float
+        The largest ratio (peak over own limit) among the search samples.
+    violations_found : int
+        Search samples that violate force, stroke or stability.
+    added : tuple of SeatParameters
+        The seats added for the next round.
+    seconds : float
+    """
+
+    index: int
+    plants: tuple
+    design: RefinedDesign
+    worst_found: float
+    violations_found: int
+    added: tuple
+    seconds: float
+
+
+@dataclass(frozen=True)
+class OccupantDesign:
+    """The result of :func:`refine_for_occupants`.
+
+    Attributes
+    ----------
+    K : control.StateSpace
+        The last round's controller ``y = [x1, x3]`` (m) to ``u`` (N).
+    design : RefinedDesign
+        The last round's refinement (its ``options.plants`` are the final seats).
+    rounds : tuple of OccupantRound
+    seconds : float
+    """
+
+    K: control.StateSpace
+    design: RefinedDesign
+    rounds: tuple
+    seconds: float
+
+
+def _search(K, seats, opts: RefineOptions, road: RoadInput) -> list:
+    """``(violation, ratio, seat)`` of each search seat: violation is the largest relative
+    excess over the force or stroke bound (inf where the delay-free loop is unstable)."""
+    from .limit import bump_limit
+
+    out = []
+    for p in seats:
+        if np.max(loop_poles(K, p).real) >= 0:
+            out.append((np.inf, np.inf, p))
+            continue
+        z, u, x1 = BumpResponse(road=road, delays=tuple(opts.delays), params=p).peaks(K)
+        limit = bump_limit(road, p, dt=_LIMIT_DT).certified_peak
+        violation = max(float(np.max(u)) / opts.u_bound - 1, float(np.max(x1)) / opts.z_bound - 1)
+        out.append((violation, float(np.max(z)) / limit, p))
+    return out
+
+
+def refine_for_occupants(K0, occupants: OccupantSet | None = None,
+                         options: RefineOptions | None = None, *, rng: np.random.Generator,
+                         rounds: int = 3, n_search: int = 40, add: int = 2,
+                         corners=("m3", "k1"), design=None, road: RoadInput | None = None,
+                         progress: Callable[[OccupantRound], None] | None = None
+                         ) -> OccupantDesign:
+    """Refine a seat controller for every seat of a set (see the module docstring).
+
+    Parameters
+    ----------
+    K0 : control.StateSpace
+        Start controller whose loop is stable at the design seat.
+    occupants : OccupantSet, optional
+        The set (30–70 kg, springs and dampers ±20 %, delay 0–25 ms by default).
+    options : RefineOptions, optional
+        The requirements; ``options.plants``, if any, are the first round's seats, else
+        the corners of ``corners``' ranges (:meth:`~.occupants.OccupantSet.corners`).
+        ``options.max_iter`` is per round.
+    rng : numpy.random.Generator
+        Draws the search samples.
+    rounds, n_search, add : int
+        Bounds of the loop: rounds, search samples per round, seats added per round.
+    corners : tuple of str
+    design : SeatDesignOptions, optional
+        The µ weights and delay cover of the refinement.
+    road : RoadInput, optional
+        The paper's bump by default.
+    progress : callable, optional
+        Called with each :class:`OccupantRound`.
+
+    Returns
+    -------
+    OccupantDesign
+    """
+    t0 = time.perf_counter()
+    occupants = OccupantSet() if occupants is None else occupants
+    opts = RefineOptions() if options is None else options
+    if not isinstance(opts, RefineOptions):
+        raise ParameterError(f"options must be a RefineOptions, got {type(opts).__name__}")
+    for name, v in (("rounds", rounds), ("n_search", n_search), ("add", add)):
+        if isinstance(v, bool) or not isinstance(v, int) or v < 1:
+            raise ParameterError(f"{name} must be a positive int, got {v!r}")
+    if not isinstance(rng, np.random.Generator):
+        raise ParameterError("rng must be a numpy.random.Generator (seeded by the caller)")
+    road = bump() if road is None else road
+    plants = opts.plants or occupants.corners(tuple(corners))
+    K, history = K0, []
+    for index in range(1, rounds + 1):
+        t_round = time.perf_counter()
+        d = refine_seat_controller(K, replace(opts, plants=tuple(plants)), design=design,
+                                   params=occupants.nominal, road=road)
+        K = d.K
+        seats, _ = occupants.sample(n_search, rng)
+        found = _search(K, seats, opts, road)
+        worst = float(np.max(d.peak))
+        # violations first (worst first), then ratios above the seats' worst
+        ranked = sorted(found, key=lambda f: (-f[0], -f[1]))
+        added = tuple(p for v, r, p in ranked
+                      if v > 0 or r > worst * (1 + _ADD_TOL))[:add]
+        rec = OccupantRound(index=index, plants=tuple(plants), design=d,
+                            worst_found=max(f[1] for f in found),
+                            violations_found=sum(f[0] > 0 for f in found), added=added,
+                            seconds=time.perf_counter() - t_round)
+        history.append(rec)
+        logger.info("occupant round %d: %d seats, worst ratio %.3f on them, %.3f on the "
+                    "search (%d violations), %d added (%.0f s)", index, len(plants) + 1,
+                    worst, rec.worst_found, rec.violations_found, len(added), rec.seconds)
+        if progress is not None:
+            progress(rec)
+        if not added:
+            break
+        plants = tuple(plants) + added
+    return OccupantDesign(K=K, design=history[-1].design, rounds=tuple(history),
+                          seconds=time.perf_counter() - t0)

@@ -1,0 +1,61 @@
+"""The refinement over a set of seats with a worst-case search (issue 38): the loop's
+invariants, each recomputed in the test (the limit LP, the FFT road figures and the
+delay-free loop's poles), on a short run; the full design is certified in the note of
+issue 38 by ``certify_occupants`` on samples the search never drew."""
+
+import numpy as np
+import pytest
+
+from lmi_suspension.errors import ParameterError
+from lmi_suspension.seat import refine
+from lmi_suspension.seat.limit import bump_limit
+from lmi_suspension.seat.multimodel import refine_for_occupants
+from lmi_suspension.seat.occupants import OccupantSet
+from lmi_suspension.seat.refine import BumpResponse, RefineOptions, load_refined, loop_poles
+from lmi_suspension.seat.roads import bump
+
+
+@pytest.fixture(scope="module")
+def K_refined():
+    return load_refined()[0]
+
+
+@pytest.mark.parametrize("kwargs", [dict(rounds=0), dict(n_search=1.5), dict(add=True),
+                                    dict(rng=0), dict(options="defaults")])
+def test_bad_arguments_raise(K_refined, kwargs):
+    args = dict(rng=np.random.default_rng(0))
+    args.update(kwargs)
+    with pytest.raises(ParameterError):
+        refine_for_occupants(K_refined, **args)
+
+
+@pytest.mark.slow
+def test_rounds_add_the_seats_the_search_fails_on(K_refined, monkeypatch):
+    """Two one-iteration rounds on a light occupant set, the search on 4 samples: every
+    added seat violates a bound or exceeds the round's worst ratio by 1 % (recomputed
+    here), the next round serves exactly the previous seats plus the added ones, and the
+    loop stops only when nothing is added or the rounds are spent."""
+    monkeypatch.setattr(refine, "_STAGE_ITER", 1)
+    occupants = OccupantSet(m3=(40.0, 70.0), stiffness_rel=0.2, damping_rel=0.0)
+    opts = RefineOptions(max_iter=1)
+    road = bump()
+    d = refine_for_occupants(K_refined, occupants, opts, rng=np.random.default_rng(1),
+                             rounds=2, n_search=4, add=1, corners=("m3",), road=road)
+    assert 1 <= len(d.rounds) <= 2
+    assert d.rounds[0].plants == occupants.corners(("m3",))
+    for r, nxt in zip(d.rounds, d.rounds[1:]):
+        assert nxt.plants == r.plants + r.added
+    last = d.rounds[-1]
+    assert len(d.rounds) == 2 or last.added == ()
+    assert d.K is last.design.K and d.design.options.plants == last.plants
+    for r in d.rounds:
+        assert len(r.added) <= 1
+        worst = float(np.max(r.design.peak))
+        for p in r.added:
+            K = r.design.K
+            if np.max(loop_poles(K, p).real) >= 0:
+                continue                                    # unstable: a violation
+            z, u, x1 = BumpResponse(road=road, params=p).peaks(K)
+            ratio = np.max(z) / bump_limit(road, p).certified_peak
+            assert (np.max(u) > opts.u_bound or np.max(x1) > opts.z_bound
+                    or ratio > worst * 1.01)
