@@ -14,7 +14,7 @@ from matplotlib.ticker import NullFormatter
 
 __all__ = ["plot_bounded_response", "plot_commanded_force", "plot_constrained_tradeoff",
            "plot_force_tradeoff", "plot_mu_bounds", "plot_peak_vs_delay", "plot_responses",
-           "plot_road"]
+           "plot_occupants", "plot_road"]
 
 _LABELS = {
     "z3dd": ("upper-body acceleration $\\ddot z_3$", "m/s²"),
@@ -353,4 +353,54 @@ def plot_bounded_response(sim, *, u_max: float, z_max: float, title: str = "") -
     axes[-1].set_xlabel("time [s]")
     axes[-1].set_xlim(0, min(float(sim.t[-1]), 1.5))
     fig.suptitle(title)
+    return fig
+
+
+def plot_occupants(check, samples, *, x: str = "m3", y: str = "k1", title: str = "") -> Figure:
+    """A controller over a set of seats (:func:`~lmi_suspension.seat.occupants.certify_occupants`):
+    each performance sample in the ``x`` × ``y`` plane, coloured by its worst peak over its
+    own limit across the delays; stability samples whose loop is unstable marked ×; the
+    worst sample ringed.
+
+    Parameters
+    ----------
+    check : OccupantCheck
+    samples : OccupantSamples
+        The samples ``check`` was computed on.
+    x, y : str
+        The :class:`~lmi_suspension.seat.SeatParameters` fields of the axes.
+    """
+    from matplotlib.colors import Normalize
+
+    fig = Figure(figsize=(7, 4.6), layout="constrained")
+    ax = fig.subplots()
+    worst = np.max(check.ratio, axis=1)
+    stable = np.isfinite(worst)
+    px = np.array([getattr(p, x) for p in samples.performance])
+    py = np.array([getattr(p, y) for p in samples.performance])
+    norm = Normalize(vmin=1.0, vmax=max(float(np.max(worst[stable], initial=1.0)), 1.5))
+    sc = ax.scatter(px[stable], py[stable], c=worst[stable], cmap="viridis", norm=norm, s=22,
+                    label="performance samples")
+    fig.colorbar(sc, ax=ax, label="worst peak $|\\ddot z_3|$ / own limit, 0–25 ms")
+    if np.any(~stable):
+        ax.scatter(px[~stable], py[~stable], marker="s", facecolors="none",
+                   edgecolors="k", s=30, label="loop unstable at a delay")
+    if check.unstable_samples:
+        ux = [getattr(p, x) for p, _ in check.unstable_samples]
+        uy = [getattr(p, y) for p, _ in check.unstable_samples]
+        ax.scatter(ux, uy, marker="x", color="r", s=30,
+                   label=f"unstable stability samples ({check.unstable} of "
+                         f"{check.n_stability}; first {len(ux)} shown)")
+    if np.isfinite(check.worst_ratio):
+        wx, wy = getattr(check.worst_sample, x), getattr(check.worst_sample, y)
+        ax.plot(wx, wy, "o", ms=14, mfc="none", mec="r")
+        ax.annotate(f"worst {check.worst_ratio:.2f} × at {check.worst_delay * 1e3:.0f} ms",
+                    (wx, wy), textcoords="offset points", xytext=(10, 8), fontsize=8)
+    units = {"m3": "kg", "k1": "N/m", "k2": "N/m", "k3": "N/m", "c1": "N·s/m",
+             "c2": "N·s/m", "c3": "N·s/m"}
+    ax.set_xlabel(f"{x} [{units.get(x, '')}]")
+    ax.set_ylabel(f"{y} [{units.get(y, '')}]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=7, loc="best")
+    ax.set_title(title)
     return fig
