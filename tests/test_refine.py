@@ -281,3 +281,18 @@ def test_with_plants_each_seat_counts_against_its_own_limit(monkeypatch):
     # for the shipped controller): the plant, not only the design seat, sets the figure
     assert peaks[1][0][0] / limits[1] > peaks[0][0][0] / limits[0]
     assert d.peak[0] == pytest.approx(peaks[1][0][0] / limits[1], rel=1e-9)
+
+
+def test_without_performance_mu_the_design_seat_asks_robust_stability_only(monkeypatch):
+    """``mu_performance=False``: the search's µ is the delay cover's gain (σ̄ of its
+    channel, recomputed here from the LFT), below the robust-performance µ of the same
+    controller."""
+    monkeypatch.setattr(refine, "_STAGE_ITER", 1)
+    K0 = load_refined()[0]
+    d = refine_seat_controller(K0, RefineOptions(max_iter=1, mu_performance=False))
+    aug = seat_augmented_plant(DEFAULT_DESIGN)
+    M = freqresp(lft(aug.P, d.K, aug.nmeas, aug.ncon), refine._MU_GRID)
+    assert d.mu == pytest.approx(np.max(np.abs(M[0, 0, :])), rel=1e-9)
+    assert np.max(TwoBlockMu(DEFAULT_DESIGN, refine._MU_GRID).curve(d.K)) > d.mu
+    with pytest.raises(ParameterError, match="mu_performance"):
+        RefineOptions(mu_performance=1)

@@ -91,12 +91,16 @@ class OccupantDesign:
 
 def _search(K, seats, opts: RefineOptions, road: RoadInput) -> list:
     """``(violation, ratio, seat)`` of each search seat: violation is the largest relative
-    excess over the force or stroke bound (inf where the delay-free loop is unstable)."""
+    excess over the force or stroke bound (inf where the loop is unstable without delay
+    or at one of ``opts.delays``)."""
     from .limit import bump_limit
+
+    from .simulate import closed_loop_stable
 
     out = []
     for p in seats:
-        if np.max(loop_poles(K, p).real) >= 0:
+        if np.max(loop_poles(K, p).real) >= 0 \
+                or not all(closed_loop_stable(K, float(d), p) for d in opts.delays):
             out.append((np.inf, np.inf, p))
             continue
         z, u, x1 = BumpResponse(road=road, delays=tuple(opts.delays), params=p).peaks(K)

@@ -505,6 +505,11 @@ class RefineOptions:
         objective is each seat's peak ``|z̈3|`` over *its own* physical limit
         (:func:`~.limit.bump_limit` on the road), the worst over the design's seat and
         the plants; without, the design seat's peak in m/s².
+    mu_performance : bool
+        At the design seat, ``mu_max`` bounds µ over the delay cover *and* the
+        performance block (robust performance of the µ weights, True), or the delay
+        cover's gain alone, as at the plants (robust stability, False: the road
+        requirements are then the only performance asked for).
     """
 
     u_bound: float = 1500.0
@@ -514,6 +519,7 @@ class RefineOptions:
     delays: tuple = REFINE_DELAYS
     max_iter: int = 600
     plants: tuple = ()
+    mu_performance: bool = True
 
     def __post_init__(self):
         for name in ("u_bound", "z_bound", "mu_max", "disk_radius"):
@@ -527,6 +533,8 @@ class RefineOptions:
             if not isinstance(p, SeatParameters):
                 raise ParameterError(f"plants must hold SeatParameters, got {type(p).__name__}")
         object.__setattr__(self, "plants", plants)
+        if not isinstance(self.mu_performance, bool):
+            raise ParameterError("mu_performance must be True or False")
 
 
 @dataclass(frozen=True)
@@ -653,10 +661,13 @@ class _Problem:
             z = np.concatenate([zs / s.unit for (zs, _, _), s in zip(peaks, self.seats)])
             u = np.concatenate([p[1] for p in peaks])
             x1 = np.concatenate([p[2] for p in peaks])
-            curve, top, _ = self.mu.peaks(K, _PEAKS)
-            mu = np.concatenate([curve, top, self.mu.curve(K, _resonance_points(pa))]
-                                + [s.cover.cover_gain(K) for s in self.seats
-                                   if s.cover is not None])
+            if self.opts.mu_performance:
+                curve, top, _ = self.mu.peaks(K, _PEAKS)
+                rp = [curve, top, self.mu.curve(K, _resonance_points(pa))]
+            else:
+                rp = [self.mu.cover_gain(K)]
+            mu = np.concatenate(rp + [s.cover.cover_gain(K) for s in self.seats
+                                      if s.cover is not None])
         b = self.bounds
         mags = np.sort(np.abs(np.concatenate([poles, np.linalg.eigvals(K.A)])))
         shape = _shape_margins(poles)
@@ -983,6 +994,8 @@ def save_refined(path, d: RefinedDesign, *, dt: float = 1e-3) -> Path:
             "discretisation": f"Tustin, dt = {dt} s"}
     if o.plants:
         meta["plants"] = [asdict(p) for p in o.plants]
+    if not o.mu_performance:
+        meta["mu_performance"] = False
     return save_controller(path, d.K, inputs=["x1", "x3"], outputs=["u"], metadata=meta,
                            discrete=discretise_controller(d.K, dt))
 
