@@ -215,6 +215,8 @@ def _cmd_refine(args: argparse.Namespace) -> int:
         K0, _ = load_controller(args.controller)
     else:
         K0 = design_mu_controller().K
+    if args.occupants:
+        return _cmd_refine_occupants(args, K0, sys.stderr)
     opts = RefineOptions(u_bound=args.u_bound, z_bound=args.z_bound,
                          disk_radius=args.disk_radius, max_iter=args.max_iter)
     d = refine_seat_controller(K0, opts, callback=on_stage)
@@ -235,6 +237,94 @@ def _cmd_refine(args: argparse.Namespace) -> int:
                      f"{c.delay_margin * 1e3:.0f} ms; requirements met: {d.met}; "
                      f"{d.seconds:.0f} s; written to {out}\n")
     return 0 if d.met else 1
+
+
+def _cmd_refine_occupants(args, K0, on_stage_out) -> int:
+    """``refine --occupants``: the refinement over the set's seats with a worst-case
+    search (:func:`~lmi_suspension.seat.multimodel.refine_for_occupants`)."""
+    from pathlib import Path
+
+    import numpy as np
+
+    from .errors import ParameterError
+    from .seat.multimodel import refine_for_occupants
+    from .seat.refine import RefineOptions, save_refined
+
+    def on_round(r):
+        on_stage_out.write(
+            f"round {r.index}: {len(r.plants) + 1} seats, worst peak/limit "
+            f"{np.max(r.design.peak):.3f}, |u| {np.max(r.design.u_peak):.0f} N, met "
+            f"{r.design.met}; search: worst {r.worst_found:.3f}, {r.violations_found} "
+            f"violations, {len(r.added)} seats added ({r.seconds:.0f} s)\n")
+
+    if not args.out:
+        raise ParameterError("refine --occupants: give --out (the shipped file is the "
+                             "single-seat design's)")
+    opts = RefineOptions(u_bound=args.u_bound, z_bound=args.z_bound,
+                         disk_radius=args.disk_radius, max_iter=args.max_iter,
+                         mu_performance=False)
+    d = refine_for_occupants(K0, None, opts, rng=np.random.default_rng(args.seed),
+                             rounds=args.rounds, progress=on_round)
+    out = save_refined(Path(args.out), d.design)
+    sys.stdout.write(f"{len(d.rounds)} rounds, {d.seconds:.0f} s; written to {out}; certify "
+                     f"it with: lmi-suspension occupants {out}\n")
+    return 0 if d.design.met else 1
+
+
+def _cmd_occupants(args: argparse.Namespace) -> int:
+    """Certify controllers over the set of occupants, springs, dampers and delays."""
+    import json
+    from pathlib import Path
+
+    import numpy as np
+
+    from .errors import ParameterError
+    from .io import load_controller
+    from .report.figures import plot_occupants
+    from .seat.occupants import certify_occupants, occupant_mu, occupant_samples
+
+    controllers = {Path(c).stem: load_controller(c)[0] for c in args.controllers}
+    if len(controllers) != len(args.controllers):
+        raise ParameterError("two controllers share a file name; rename one")
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    log = sys.stderr if not args.quiet else None
+    say = (lambda line: log.write(line + "\n")) if log is not None else None
+    S = occupant_samples(rng=np.random.default_rng(args.seed), n_stability=args.stability,
+                         n_performance=args.performance, progress=say)
+    rows = {}
+    sys.stdout.write(f"{'controller':>14} {'unstable':>12} {'worst/limit':>11} "
+                     f"{'nominal':>8} {'|u| [N]':>8} {'|x1| [m]':>9} {'poles [rad/s]':>13}"
+                     f"{'  RS µ (lower)   RP µ (lower)' if args.mu else ''}\n")
+    for name, K in controllers.items():
+        c = certify_occupants(K, S, progress=say)
+        row = dict(unstable=c.unstable, n_stability=c.n_stability,
+                   worst_ratio=c.worst_ratio, worst_delay=c.worst_delay,
+                   worst_sample={k: getattr(c.worst_sample, k) for k in
+                                 ("m3", "k1", "k2", "k3", "c1", "c2", "c3")},
+                   nominal_ratio=c.nominal_ratio, u_max=c.u_max, x1_max=c.x1_max,
+                   controller_radius=c.controller_radius, loop_radius=c.loop_radius,
+                   n_performance=len(S.performance), delays=list(c.delays),
+                   confirmed=[list(x) for x in c.confirmed])
+        line = (f"{name:>14} {c.unstable:>5}/{c.n_stability:<6} {c.worst_ratio:11.3f} "
+                f"{c.nominal_ratio:8.3f} {c.u_max:8.0f} {c.x1_max:9.4f} "
+                f"{max(c.controller_radius, c.loop_radius):13.0f}")
+        if args.mu:
+            m = occupant_mu(K, rng=np.random.default_rng(args.seed))
+            row.update(rs_upper=m.rs_upper, rs_lower=m.rs_lower, rp_upper=m.rp_upper,
+                       rp_lower=m.rp_lower)
+            line += (f"  {m.rs_upper:6.3f} ({m.rs_lower:5.3f})  {m.rp_upper:6.3f} "
+                     f"({m.rp_lower:5.3f})")
+        sys.stdout.write(line + "\n")
+        fig = plot_occupants(c, S, title=f"{name}: {len(S.performance)} seats × "
+                                         f"{len(c.delays)} delays")
+        fig.savefig(out / f"occupants_{name}.png", dpi=110)
+        rows[name] = row
+    (out / "occupants.json").write_text(json.dumps(
+        dict(seed=args.seed, n_stability=args.stability, n_performance=args.performance,
+             nominal_limit=S.nominal_limit, controllers=rows), indent=1, default=float))
+    sys.stdout.write(f"written: {out / 'occupants.json'} and occupants_<controller>.png\n")
+    return 0
 
 
 def _cmd_tradeoff(args: argparse.Namespace) -> int:
@@ -523,10 +613,39 @@ def build_parser() -> argparse.ArgumentParser:
     p_rf.add_argument("--z-bound", type=float, default=0.08, help="|x1| on the bump, m")
     p_rf.add_argument("--disk-radius", type=float, default=1900.0,
                       help="controller and loop poles in |s| < this, rad/s")
-    p_rf.add_argument("--max-iter", type=int, default=600, help="SLSQP iterations in all")
+    p_rf.add_argument("--max-iter", type=int, default=600,
+                      help="SLSQP iterations in all (with --occupants: per round)")
     p_rf.add_argument("--out", default=None,
                       help="controller file to write (default: the one shipped in the package)")
+    p_rf.add_argument("--occupants", action="store_true",
+                      help="refine for every seat of 30-70 kg, springs and dampers ±20 %%: "
+                           "rounds of refinement on a growing set of seats, each followed "
+                           "by a worst-case search (robust stability of the delay cover "
+                           "instead of the µ weights' robust performance)")
+    p_rf.add_argument("--rounds", type=int, default=3, help="with --occupants: rounds")
+    p_rf.add_argument("--seed", type=int, default=0,
+                      help="with --occupants: seed of the worst-case search's samples")
     p_rf.set_defaults(func=_cmd_refine)
+
+    p_oc = sub.add_parser("occupants",
+                          help="certify controllers over occupants of 30-70 kg, springs and "
+                               "dampers ±20 %%, delays 0-25 ms: exact-delay Nyquist on "
+                               "Latin-hypercube samples, the bump at 0-25 ms against each "
+                               "sample's own limit, and mixed µ (--mu); a table, a JSON "
+                               "file and one map per controller")
+    p_oc.add_argument("controllers", nargs="+", help="controller JSON files")
+    p_oc.add_argument("--stability", type=int, default=10_000,
+                      help="stability samples (about 6 ms each)")
+    p_oc.add_argument("--performance", type=int, default=200,
+                      help="performance samples, each met at 0, 5, ..., 25 ms (about 0.8 s "
+                           "each, mostly its own limit's LP)")
+    p_oc.add_argument("--seed", type=int, default=2026, help="seed of the samples")
+    p_oc.add_argument("--mu", action="store_true",
+                      help="also mixed µ, robust stability and performance (minutes per "
+                           "controller)")
+    p_oc.add_argument("--out", default="occupants_out", help="output folder")
+    p_oc.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
+    p_oc.set_defaults(func=_cmd_occupants)
 
     p_to = sub.add_parser("tradeoff",
                           help="the force bound's price: one design-constrained per bound "

@@ -155,3 +155,36 @@ def test_refine_writes_a_controller_and_its_certificate(capsys, tmp_path):
     assert float(row[1]) == pytest.approx(m.peak_z3dd, abs=1e-3)
     assert float(row[3]) == pytest.approx(m.peak_u_command, abs=0.5)
     assert "µ upper" in text
+
+
+def test_occupants_certifies_and_draws_each_controller(capsys, tmp_path):
+    """``occupants`` on the shipped refined controller and a second copy of it, with a
+    few samples: one table row and one map per controller, the JSON holds what the
+    library's certificate computes on the same seeded samples."""
+    from lmi_suspension.seat.occupants import certify_occupants, occupant_samples
+    from lmi_suspension.seat.refine import SHIPPED_REFINED, load_refined
+
+    copy = tmp_path / "again.json"
+    copy.write_bytes(SHIPPED_REFINED.read_bytes())
+    out = tmp_path / "occ"
+    assert main(["occupants", str(SHIPPED_REFINED), str(copy), "--stability", "30",
+                 "--performance", "2", "--seed", "4", "--out", str(out), "-q"]) == 0
+    text = capsys.readouterr().out
+    assert text.count("mu_refined") == 1 and text.count("again") == 1
+    table = json.loads((out / "occupants.json").read_text())
+    assert set(table["controllers"]) == {"mu_refined", "again"}
+    S = occupant_samples(rng=np.random.default_rng(4), n_stability=30, n_performance=2)
+    c = certify_occupants(load_refined()[0], S, confirm=3)
+    for row in table["controllers"].values():
+        assert row["unstable"] == c.unstable
+        assert row["worst_ratio"] == pytest.approx(c.worst_ratio, rel=1e-12)
+        assert row["u_max"] == pytest.approx(c.u_max, rel=1e-12)
+    for name in ("mu_refined", "again"):
+        assert imread(out / f"occupants_{name}.png").shape[2] in (3, 4)
+
+
+def test_refine_for_occupants_needs_an_output_file(capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(["refine", "--occupants", "--max-iter", "1"])
+    assert exc.value.code == 2
+    assert "--out" in capsys.readouterr().err
