@@ -59,3 +59,28 @@ def test_rounds_add_the_seats_the_search_fails_on(K_refined, monkeypatch):
             ratio = np.max(z) / bump_limit(road, p).certified_peak
             assert (np.max(u) > opts.u_bound or np.max(x1) > opts.z_bound
                     or ratio > worst * 1.01)
+
+
+def test_shipped_multiseat_design_is_stable_on_sampled_seats_and_meets_its_seats():
+    """The shipped file: its loop is stable at 300 seeded Latin-hypercube seats and delays
+    (exact-delay Nyquist, against the delay-free loop's poles at the seats where the
+    delay is below 1 ms), and at the design seat the time-stepping simulation keeps the
+    force and stroke bounds the search met (within the search's margin, 3e-3)."""
+    from lmi_suspension.seat.multimodel import SHIPPED_OCCUPANTS
+    from lmi_suspension.seat.occupants import OccupantSamples
+    from lmi_suspension.seat.occupants import certify_occupants
+    from lmi_suspension.seat.simulate import simulate
+
+    K, Kd, meta = load_refined(SHIPPED_OCCUPANTS)
+    assert meta["met"] is True and len(meta["plants"]) == 9 and Kd.dt == 1e-3
+    occupants = OccupantSet()
+    seats, delays = occupants.sample(300, np.random.default_rng(11))
+    S = OccupantSamples(occupants=occupants, stability=seats, stability_delays=delays,
+                        performance=(), limits=np.zeros(0), nominal_limit=1.0, road=bump())
+    c = certify_occupants(K, S, confirm=0)
+    assert c.unstable == 0
+    assert all(np.max(loop_poles(K, p).real) < 0 for p, d in zip(seats, delays) if d < 1e-3)
+    for d in (0.0, 0.025):
+        m = simulate(K, bump(), delay=d, u_max=np.inf).metrics()
+        assert m.peak_u_command <= meta["u_bound"] * (1 + 3e-3)
+        assert m.peak_x1 <= meta["z_bound"]

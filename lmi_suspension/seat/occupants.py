@@ -269,8 +269,11 @@ class OccupantCheck:
     worst_ratio : float
     worst_sample : SeatParameters
     worst_delay : float
+        The largest ratio, its sample and delay (nan, None, nan without performance
+        samples).
     u_max, x1_max : float
-        Largest commanded ``|u|`` and ``|x1|`` over every sample and delay.
+        Largest commanded ``|u|`` and ``|x1|`` over every sample and delay (-inf without
+        performance samples).
     nominal_ratio : float
         The nominal seat's worst over the delays.
     confirmed : tuple of (int, float, str, float, float)
@@ -368,13 +371,17 @@ def certify_occupants(K, samples: OccupantSamples, *, delays=None, confirm: int 
             confirmed.append((i, delays[j], name, float(table[i, j]), float(value)))
             table[i, j] = max(table[i, j], value)
     nominal = BumpResponse(road=road, delays=delays, params=samples.occupants.nominal)
-    finite = np.where(np.isnan(ratio), -np.inf, ratio)
-    i, j = np.unravel_index(int(np.argmax(finite)), ratio.shape)
+    if n:
+        i, j = np.unravel_index(int(np.argmax(np.where(np.isnan(ratio), -np.inf, ratio))),
+                                ratio.shape)
+        worst = (float(ratio[i, j]), samples.performance[i], delays[j])
+    else:                                   # stability samples only
+        worst = (math.nan, None, math.nan)
     return OccupantCheck(
         n_stability=len(samples.stability), unstable=len(unstable),
         unstable_samples=tuple(unstable[:20]), delays=delays, ratio=ratio, u_peak=u,
-        x1_peak=x1, worst_ratio=float(ratio[i, j]), worst_sample=samples.performance[i],
-        worst_delay=delays[j], u_max=float(np.max(u)), x1_max=float(np.max(x1)),
+        x1_peak=x1, worst_ratio=worst[0], worst_sample=worst[1], worst_delay=worst[2],
+        u_max=float(np.max(u, initial=-np.inf)), x1_max=float(np.max(x1, initial=-np.inf)),
         nominal_ratio=float(np.max(nominal.peaks(K)[0]) / samples.nominal_limit),
         confirmed=tuple(confirmed),
         controller_radius=float(np.max(np.abs(np.linalg.eigvals(K.A)), initial=0.0)),

@@ -993,6 +993,9 @@ def save_refined(path, d: RefinedDesign, *, dt: float = 1e-3) -> Path:
             "met": d.met, "iterations": d.iterations, "design_seconds": d.seconds,
             "discretisation": f"Tustin, dt = {dt} s"}
     if o.plants:
+        meta["description"] = (f"seat controller refined to exact bump requirements at the "
+                               f"design seat and {len(o.plants)} further seats: "
+                               f"y = [x1, x3] (m) -> u (N)")
         meta["plants"] = [asdict(p) for p in o.plants]
     if not o.mu_performance:
         meta["mu_performance"] = False
