@@ -200,6 +200,7 @@ def _cmd_design_constrained(args: argparse.Namespace) -> int:
 def _cmd_refine(args: argparse.Namespace) -> int:
     from pathlib import Path
 
+    from .errors import ParameterError
     from .seat.design import design_mu_controller
     from .seat.refine import (SHIPPED_REFINED, RefineOptions, certify_refined,
                               refine_seat_controller, save_refined)
@@ -209,6 +210,9 @@ def _cmd_refine(args: argparse.Namespace) -> int:
                          f"peak {rec.peak:.3f} m/s², |u| {rec.u_peak:.0f} N, µ {rec.mu:.4f}, "
                          f"poles {rec.radius:.0f} rad/s ({rec.seconds:.0f} s)\n")
 
+    if args.occupants and not args.out:
+        raise ParameterError("refine --occupants: give --out (the shipped file is the "
+                             "single-seat design's)")
     if args.controller:
         from .io import load_controller
 
@@ -246,7 +250,6 @@ def _cmd_refine_occupants(args, K0, on_stage_out) -> int:
 
     import numpy as np
 
-    from .errors import ParameterError
     from .seat.multimodel import refine_for_occupants
     from .seat.refine import RefineOptions, save_refined
 
@@ -257,9 +260,6 @@ def _cmd_refine_occupants(args, K0, on_stage_out) -> int:
             f"{r.design.met}; search: worst {r.worst_found:.3f}, {r.violations_found} "
             f"violations, {len(r.added)} seats added ({r.seconds:.0f} s)\n")
 
-    if not args.out:
-        raise ParameterError("refine --occupants: give --out (the shipped file is the "
-                             "single-seat design's)")
     opts = RefineOptions(u_bound=args.u_bound, z_bound=args.z_bound,
                          disk_radius=args.disk_radius, max_iter=args.max_iter,
                          mu_performance=False)
@@ -274,6 +274,7 @@ def _cmd_refine_occupants(args, K0, on_stage_out) -> int:
 def _cmd_occupants(args: argparse.Namespace) -> int:
     """Certify controllers over the set of occupants, springs, dampers and delays."""
     import json
+    import math
     from pathlib import Path
 
     import numpy as np
@@ -319,7 +320,8 @@ def _cmd_occupants(args: argparse.Namespace) -> int:
         fig = plot_occupants(c, S, title=f"{name}: {len(S.performance)} seats × "
                                          f"{len(c.delays)} delays")
         fig.savefig(out / f"occupants_{name}.png", dpi=110)
-        rows[name] = row
+        rows[name] = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
+                      for k, v in row.items()}   # strict JSON: null for an unstable loop
     (out / "occupants.json").write_text(json.dumps(
         dict(seed=args.seed, n_stability=args.stability, n_performance=args.performance,
              nominal_limit=S.nominal_limit, controllers=rows), indent=1, default=float))

@@ -84,3 +84,24 @@ def test_shipped_multiseat_design_is_stable_on_sampled_seats_and_meets_its_seats
         m = simulate(K, bump(), delay=d, u_max=np.inf).metrics()
         assert m.peak_u_command <= meta["u_bound"] * (1 + 3e-3)
         assert m.peak_x1 <= meta["z_bound"]
+
+
+def test_search_ranks_violations_then_ratios_and_stops_at_an_unstable_seat(K_refined,
+                                                                          monkeypatch):
+    """Injected search results: a violation is added before any ratio, ratios largest
+    first, a seat with an unstable loop is reported and not added, and it ends the loop
+    (the next refinement could not start from that loop)."""
+    from lmi_suspension.seat import multimodel
+    from lmi_suspension.seat.params import SeatParameters
+
+    monkeypatch.setattr(refine, "_STAGE_ITER", 1)
+    A, B, C, D = (SeatParameters(m3=m) for m in (31.0, 32.0, 33.0, 34.0))
+    found = [(np.inf, np.inf, A), (-0.05, 50.0, B), (-0.30, 60.0, C), (0.1, 1.0, D)]
+    monkeypatch.setattr(multimodel, "_search", lambda K, seats, opts, road: found)
+    d = refine_for_occupants(K_refined, OccupantSet(damping_rel=0.0),
+                             RefineOptions(max_iter=1), rng=np.random.default_rng(0),
+                             rounds=3, n_search=4, add=2, corners=("m3",))
+    assert len(d.rounds) == 1
+    r = d.rounds[0]
+    assert r.added == (D, C) and r.unstable == (A,)
+    assert r.violations_found == 2 and r.worst_found == np.inf

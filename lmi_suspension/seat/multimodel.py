@@ -10,8 +10,9 @@ the worst of each seat's peak ``|z̈3|`` over its own physical limit is minimise
 ``n_search`` Latin-hypercube samples of the :class:`~.occupants.OccupantSet` are met by
 the result; the samples that violate a requirement, or whose ratio exceeds the rounds'
 worst over its seats, are added (at most ``add`` per round, the worst first), and the
-next round starts from the result.  The loop ends when a search finds nothing to add or
-after ``rounds`` rounds.
+next round starts from the result.  The loop ends when a search finds nothing to add,
+finds a seat where the loop is unstable (reported, not added: a refinement starts from a
+loop that is stable at every seat it serves), or after ``rounds`` rounds.
 
 The answer is certified by :func:`~.occupants.certify_occupants` on samples the search
 did not draw and by :func:`~.occupants.occupant_mu`.
@@ -63,6 +64,11 @@ class OccupantRound:
         Search samples that violate force, stroke or stability.
     added : tuple of SeatParameters
         The seats added for the next round.
+    unstable : tuple of SeatParameters
+        Search samples whose loop is unstable with the round's controller.  They are
+        not added: a refinement starts from a controller whose loop is stable at every
+        seat it serves.  The loop stops after a round that finds one (a user decides:
+        another start, a smaller set).
     seconds : float
     """
 
@@ -72,6 +78,7 @@ class OccupantRound:
     worst_found: float
     violations_found: int
     added: tuple
+    unstable: tuple
     seconds: float
 
 
@@ -171,13 +178,17 @@ def refine_for_occupants(K0, occupants: OccupantSet | None = None,
         seats, _ = occupants.sample(n_search, rng)
         found = _search(K, seats, opts, road)
         worst = float(np.max(d.peak))
-        # violations first (worst first), then ratios above the seats' worst
-        ranked = sorted(found, key=lambda f: (-f[0], -f[1]))
+        unstable = tuple(p for v, _, p in found if v == np.inf)
+        # violations first, the largest first; then the seats that meet the bounds, by
+        # ratio, where it exceeds the seats' worst
+        ranked = sorted((f for f in found if f[0] < np.inf),
+                        key=lambda f: (0, -f[0]) if f[0] > 0 else (1, -f[1]))
         added = tuple(p for v, r, p in ranked
                       if v > 0 or r > worst * (1 + _ADD_TOL))[:add]
         rec = OccupantRound(index=index, plants=tuple(plants), design=d,
                             worst_found=max(f[1] for f in found),
                             violations_found=sum(f[0] > 0 for f in found), added=added,
+                            unstable=unstable,
                             seconds=time.perf_counter() - t_round)
         history.append(rec)
         logger.info("occupant round %d: %d seats, worst ratio %.3f on them, %.3f on the "
@@ -185,7 +196,10 @@ def refine_for_occupants(K0, occupants: OccupantSet | None = None,
                     worst, rec.worst_found, rec.violations_found, len(added), rec.seconds)
         if progress is not None:
             progress(rec)
-        if not added:
+        if unstable:
+            logger.warning("occupant round %d: the loop is unstable at %d search seats; "
+                           "stopping (see OccupantRound.unstable)", index, len(unstable))
+        if not added or unstable:
             break
         plants = tuple(plants) + added
     return OccupantDesign(K=K, design=history[-1].design, rounds=tuple(history),

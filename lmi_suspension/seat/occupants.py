@@ -275,7 +275,7 @@ class OccupantCheck:
         Largest commanded ``|u|`` and ``|x1|`` over every sample and delay (-inf without
         performance samples).
     nominal_ratio : float
-        The nominal seat's worst over the delays.
+        The nominal seat's worst over the delays (inf if its loop is unstable at one).
     confirmed : tuple of (int, float, str, float, float)
         The time-domain re-simulations: ``(sample, delay, figure, frequency-domain value,
         time-domain value)``; the reported figures are the larger of the two.
@@ -334,6 +334,8 @@ def certify_occupants(K, samples: OccupantSamples, *, delays=None, confirm: int 
     if not isinstance(K, control.StateSpace) or K.isdtime(strict=True) \
             or K.ninputs != 2 or K.noutputs != 1:
         raise ParameterError("K must be a continuous-time StateSpace from y = [x1, x3] to u")
+    if isinstance(confirm, bool) or not isinstance(confirm, int) or confirm < 0:
+        raise ParameterError(f"confirm must be a non-negative int, got {confirm!r}")
     delays = tuple(float(d) for d in (REFINE_DELAYS if delays is None else delays))
     if not delays or any(not math.isfinite(d) or d < 0 for d in delays):
         raise ParameterError(f"delays must be finite and non-negative, got {delays!r}")
@@ -370,7 +372,10 @@ def certify_occupants(K, samples: OccupantSamples, *, delays=None, confirm: int 
                      "x1": met.peak_x1}[name]
             confirmed.append((i, delays[j], name, float(table[i, j]), float(value)))
             table[i, j] = max(table[i, j], value)
-    nominal = BumpResponse(road=road, delays=delays, params=samples.occupants.nominal)
+    nom = samples.occupants.nominal
+    nominal_ratio = (float(np.max(BumpResponse(road=road, delays=delays, params=nom)
+                                  .peaks(K)[0])) / samples.nominal_limit
+                     if all(closed_loop_stable(K, d, nom) for d in delays) else math.inf)
     if n:
         i, j = np.unravel_index(int(np.argmax(np.where(np.isnan(ratio), -np.inf, ratio))),
                                 ratio.shape)
@@ -382,7 +387,7 @@ def certify_occupants(K, samples: OccupantSamples, *, delays=None, confirm: int 
         unstable_samples=tuple(unstable[:20]), delays=delays, ratio=ratio, u_peak=u,
         x1_peak=x1, worst_ratio=worst[0], worst_sample=worst[1], worst_delay=worst[2],
         u_max=float(np.max(u, initial=-np.inf)), x1_max=float(np.max(x1, initial=-np.inf)),
-        nominal_ratio=float(np.max(nominal.peaks(K)[0]) / samples.nominal_limit),
+        nominal_ratio=nominal_ratio,
         confirmed=tuple(confirmed),
         controller_radius=float(np.max(np.abs(np.linalg.eigvals(K.A)), initial=0.0)),
         loop_radius=loop_radius, seconds=time.perf_counter() - t0)
@@ -448,6 +453,8 @@ def occupant_mu(K, occupants: OccupantSet | None = None, *, design=None, omega=N
     if names[-1] != "performance":
         raise ParameterError("the design's structure must end with the performance block")
     CL = lft(aug.P, control.ss(K.A, K.B, K.C, K.D), aug.nmeas, aug.ncon)
+    if CL.nstates and np.max(np.linalg.eigvals(np.asarray(CL.A)).real) >= 0:
+        raise ParameterError("the nominal µ loop is unstable: no µ bound certifies it")
     M = freqresp(CL, omega)
     blk = np.asarray(aug.blk)
     # Δ_perf is blk[-1, 0] × blk[-1, 1]: M's last blk[-1, 1] rows and blk[-1, 0] columns

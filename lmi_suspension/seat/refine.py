@@ -488,7 +488,9 @@ class RefineOptions:
         ``|x1|`` on the road, m, at every delay.
     mu_max : float
         µ over the delay cover and the performance block, on the search grid; below 1
-        by a margin, for the certificate on a denser grid.
+        by a margin, for the certificate on a denser grid.  With ``plants``, also the
+        delay cover's gain at each plant; with ``mu_performance=False``, that gain alone
+        at the design seat (on the grid only: a certificate needs a denser one).
     disk_radius : float
         Controller and loop poles inside ``|s| < disk_radius``, rad/s (1 kHz: Nyquist
         rate π · 1000 ≈ 3142 rad/s).
@@ -528,6 +530,9 @@ class RefineOptions:
                 raise ParameterError(f"{name} must be positive and finite, got {value!r}")
         if not (isinstance(self.max_iter, int) and self.max_iter >= 1):
             raise ParameterError(f"max_iter must be a positive int, got {self.max_iter!r}")
+        if not isinstance(self.plants, (tuple, list)):
+            raise ParameterError(f"plants must be a tuple of SeatParameters, got "
+                                 f"{type(self.plants).__name__}")
         plants = tuple(self.plants)
         for p in plants:
             if not isinstance(p, SeatParameters):
