@@ -201,16 +201,18 @@ def test_mixed_mu_keeps_the_parameters_real_and_matches_mussv(K_refined):
 
 
 def test_the_map_draws_every_sample_and_marks_the_unstable():
-    """An injected check (no computation): three performance samples, one unstable at a
-    delay, two unstable stability samples; the figure holds what the check says."""
+    """An injected check (no computation): four performance samples, one unstable at a
+    delay, one whose limit LP failed (nan ratios: not unstable), two unstable stability
+    samples; the figure holds what the check says."""
     from lmi_suspension.report.figures import plot_occupants
     from lmi_suspension.seat.occupants import OccupantCheck
 
     perf = (SeatParameters(m3=30.0), SeatParameters(m3=50.0, k1=25000.0),
-            SeatParameters(m3=70.0))
+            SeatParameters(m3=70.0), SeatParameters(m3=60.0, k1=36000.0))
     S = OccupantSamples(occupants=OccupantSet(), stability=(), stability_delays=np.zeros(0),
-                        performance=perf, limits=np.ones(3), nominal_limit=1.0, road=bump())
-    ratio = np.array([[1.2, 1.4], [np.inf, 1.3], [1.1, 1.6]])
+                        performance=perf, limits=np.array([1.0, 1.0, 1.0, np.nan]),
+                        nominal_limit=1.0, road=bump())
+    ratio = np.array([[1.2, 1.4], [np.inf, 1.3], [1.1, 1.6], [np.nan, np.nan]])
     c = OccupantCheck(n_stability=10, unstable=2,
                       unstable_samples=((SeatParameters(k1=24000.0), 0.0),
                                         (SeatParameters(k1=24500.0), 0.02)),
@@ -220,9 +222,11 @@ def test_the_map_draws_every_sample_and_marks_the_unstable():
                       loop_radius=1.0, seconds=0.0)
     fig = plot_occupants(c, S)
     ax = fig.axes[0]
-    stable, boxes, crosses = ax.collections[:3]
+    stable, boxes, no_limit, crosses = ax.collections[:4]
     assert stable.get_offsets().tolist() == [[30.0, 31000.0], [70.0, 31000.0]]
     assert np.allclose(stable.get_array(), [1.4, 1.6])
     assert boxes.get_offsets().tolist() == [[50.0, 25000.0]]
+    assert no_limit.get_offsets().tolist() == [[60.0, 36000.0]]
+    assert "LP failed" in no_limit.get_label()
     assert crosses.get_offsets().tolist() == [[43.3, 24000.0], [43.3, 24500.0]]
     assert "1.60 × at 20 ms" in ax.texts[0].get_text()

@@ -359,8 +359,9 @@ def plot_bounded_response(sim, *, u_max: float, z_max: float, title: str = "") -
 def plot_occupants(check, samples, *, x: str = "m3", y: str = "k1", title: str = "") -> Figure:
     """A controller over a set of seats (:func:`~lmi_suspension.seat.occupants.certify_occupants`):
     each performance sample in the ``x`` × ``y`` plane, coloured by its worst peak over its
-    own limit across the delays; stability samples whose loop is unstable marked ×; the
-    worst sample ringed.
+    own limit across the delays; stability samples whose loop is unstable marked ×,
+    performance samples unstable at a delay boxed, those without a limit (failed LP)
+    drawn as grey diamonds; the worst sample ringed.
 
     Parameters
     ----------
@@ -374,17 +375,24 @@ def plot_occupants(check, samples, *, x: str = "m3", y: str = "k1", title: str =
 
     fig = Figure(figsize=(7, 4.6), layout="constrained")
     ax = fig.subplots()
-    worst = np.max(check.ratio, axis=1)
-    stable = np.isfinite(worst)
+    ratio = np.asarray(check.ratio, dtype=float)
+    unstable = np.any(np.isposinf(ratio), axis=1)
+    # a sample whose limit LP failed has no ratio (nan): drawn apart, not as unstable
+    no_limit = ~unstable & np.any(np.isnan(ratio), axis=1)
+    stable = ~unstable & ~no_limit
+    worst = np.where(stable, np.max(np.where(stable[:, None], ratio, 0.0), axis=1), np.nan)
     px = np.array([getattr(p, x) for p in samples.performance])
     py = np.array([getattr(p, y) for p in samples.performance])
     norm = Normalize(vmin=1.0, vmax=max(float(np.max(worst[stable], initial=1.0)), 1.5))
     sc = ax.scatter(px[stable], py[stable], c=worst[stable], cmap="viridis", norm=norm, s=22,
                     label="performance samples")
     fig.colorbar(sc, ax=ax, label="worst peak $|\\ddot z_3|$ / own limit, 0–25 ms")
-    if np.any(~stable):
-        ax.scatter(px[~stable], py[~stable], marker="s", facecolors="none",
+    if np.any(unstable):
+        ax.scatter(px[unstable], py[unstable], marker="s", facecolors="none",
                    edgecolors="k", s=30, label="loop unstable at a delay")
+    if np.any(no_limit):
+        ax.scatter(px[no_limit], py[no_limit], marker="D", facecolors="none",
+                   edgecolors="0.5", s=26, label="own limit not computed (LP failed)")
     if check.unstable_samples:
         ux = [getattr(p, x) for p, _ in check.unstable_samples]
         uy = [getattr(p, y) for p, _ in check.unstable_samples]

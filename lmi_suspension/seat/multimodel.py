@@ -30,8 +30,9 @@ import control
 import numpy as np
 
 from ..errors import ParameterError
-from .occupants import _LIMIT_DT, OccupantSet
-from .refine import BumpResponse, RefinedDesign, RefineOptions, loop_poles, refine_seat_controller
+from .occupants import OccupantSet
+from .refine import (_LIMIT_DT, BumpResponse, RefinedDesign, RefineOptions, loop_poles,
+                     refine_seat_controller)
 from .roads import RoadInput, bump
 
 __all__ = ["OccupantRound", "OccupantDesign", "SHIPPED_OCCUPANTS", "refine_for_occupants"]

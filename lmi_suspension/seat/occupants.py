@@ -55,8 +55,6 @@ logger = logging.getLogger(__name__)
 
 #: the springs and dampers of the set, in the order of :meth:`OccupantSet.ranges`
 _ELEMENTS = ("k1", "k2", "k3", "c1", "c2", "c3")
-#: step of the limit LP, s: bump_limit's default, the sweep's and the refinement's
-_LIMIT_DT = 2e-3
 
 
 def _interval(value, name: str, *, positive: bool) -> tuple[float, float]:
@@ -224,6 +222,7 @@ def occupant_samples(occupants: OccupantSet | None = None, *, rng: np.random.Gen
         Called with a line of text every 20 limits.
     """
     from .limit import bump_limit
+    from .refine import _LIMIT_DT
 
     occupants = OccupantSet() if occupants is None else occupants
     road = bump() if road is None else road

@@ -240,11 +240,17 @@ class TwoBlockMu:
         KP21 = np.einsum("yf,ywf->wf", Kw, P21) / loop
         return np.moveaxis(P11 + P12[:, None, :] * KP21[None, :, :], -1, 0)
 
-    def cover_gain(self, K) -> np.ndarray:
-        """σ̄ of the first block's channel on the grid: µ of robust stability against
-        that block alone (one full complex block: µ is σ̄), the delay cover's."""
-        M = self._loop(K)[:, :self._c["rows"], :self._c["cols"]]
+    def cover_gain(self, K, omega=None) -> np.ndarray:
+        """σ̄ of the first block's channel on the grid, or at ``omega`` (rad/s): µ of
+        robust stability against that block alone (one full complex block: µ is σ̄),
+        the delay cover's."""
+        M = self._loop(K, omega)[:, :self._c["rows"], :self._c["cols"]]
         return np.linalg.svd(M, compute_uv=False)[:, 0]
+
+    def cover_peaks(self, K, count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The delay cover's gain on the grid and its ``count`` largest local maxima
+        refined between grid points, as :meth:`peaks` does for µ."""
+        return _zoomed_peaks(lambda w=None: self.cover_gain(K, w), self._c["omega"], count)
 
     def curve(self, K, omega=None) -> np.ndarray:
         """µ at each grid frequency, or at ``omega`` (rad/s) where given."""
@@ -285,28 +291,34 @@ class TwoBlockMu:
         number of values is fixed (the search's constraints need that).  A sharp peak
         between grid points is found this way, which a grid alone can miss.
         """
-        mu = self.curve(K)
-        w = np.log(self._c["omega"])
-        inner = np.flatnonzero((mu[1:-1] >= mu[:-2]) & (mu[1:-1] >= mu[2:])) + 1
-        if inner.size == 0:
-            inner = np.array([int(np.clip(np.argmax(mu), 1, mu.size - 2))])
-        top = inner[np.argsort(-mu[inner], kind="stable")][:count]
-        top = np.concatenate([top, np.repeat(top[:1], count)])[:count]
-        lo, hi = w[top - 1], w[top + 1]
-        best_mu, best_w = mu[top], self._c["omega"][top]
-        cols = np.arange(count)
-        for _ in range(_PEAK_ZOOMS):
-            # every peak's bracket sampled at once (one batched evaluation per zoom)
-            t = np.linspace(0.0, 1.0, _PEAK_POINTS)
-            grid = lo[:, None] + (hi - lo)[:, None] * t[None, :]        # (count, n)
-            vals = self.curve(K, np.exp(grid.ravel())).reshape(grid.shape)
-            j = np.argmax(vals, axis=1)
-            better = vals[cols, j] > best_mu
-            best_mu = np.where(better, vals[cols, j], best_mu)
-            best_w = np.where(better, np.exp(grid[cols, j]), best_w)
-            step = (hi - lo) / (_PEAK_POINTS - 1)
-            lo, hi = grid[cols, j] - step, grid[cols, j] + step
-        return mu, best_mu, best_w
+        return _zoomed_peaks(lambda w=None: self.curve(K, w), self._c["omega"], count)
+
+
+def _zoomed_peaks(f, omega: np.ndarray, count: int):
+    """``(f on the grid, its count largest local maxima refined, their frequencies)``
+    for a curve ``f(omega=None)`` given on the grid ``omega`` (see :meth:`TwoBlockMu.peaks`)."""
+    mu = f()
+    w = np.log(omega)
+    inner = np.flatnonzero((mu[1:-1] >= mu[:-2]) & (mu[1:-1] >= mu[2:])) + 1
+    if inner.size == 0:
+        inner = np.array([int(np.clip(np.argmax(mu), 1, mu.size - 2))])
+    top = inner[np.argsort(-mu[inner], kind="stable")][:count]
+    top = np.concatenate([top, np.repeat(top[:1], count)])[:count]
+    lo, hi = w[top - 1], w[top + 1]
+    best_mu, best_w = mu[top], omega[top]
+    cols = np.arange(count)
+    for _ in range(_PEAK_ZOOMS):
+        # every peak's bracket sampled at once (one batched evaluation per zoom)
+        t = np.linspace(0.0, 1.0, _PEAK_POINTS)
+        grid = lo[:, None] + (hi - lo)[:, None] * t[None, :]        # (count, n)
+        vals = f(np.exp(grid.ravel())).reshape(grid.shape)
+        j = np.argmax(vals, axis=1)
+        better = vals[cols, j] > best_mu
+        best_mu = np.where(better, vals[cols, j], best_mu)
+        best_w = np.where(better, np.exp(grid[cols, j]), best_w)
+        step = (hi - lo) / (_PEAK_POINTS - 1)
+        lo, hi = grid[cols, j] - step, grid[cols, j] + step
+    return mu, best_mu, best_w
 
 
 # ----------------------------------------------------------------------------- realization
@@ -444,7 +456,8 @@ _SHAPE_POLES = 4
 #: aims at every bound tightened by twice this fraction and counts an excess below it
 #: as met, so that what it returns is within the bounds themselves by about this much.
 _MARGIN = 3e-3
-#: step of the physical limit's LP for ``plants``, s (bump_limit's default; the sweep's)
+#: step of the physical limit's LP for ``plants``, s (bump_limit's default; the sweep's;
+#: the occupants' certificate uses it too)
 _LIMIT_DT = 2e-3
 
 
@@ -463,6 +476,16 @@ def _shape_margins(poles: np.ndarray) -> np.ndarray:
     decay = np.sort(-poles.real)[:_SHAPE_POLES] / _MIN_DECAY - 1
     zeta = np.sort(-poles.real / np.maximum(np.abs(poles), 1e-300))[:_SHAPE_POLES]
     return np.concatenate([decay, zeta / _MIN_DAMPING - 1])
+
+
+def _cover_points(mu: TwoBlockMu, K, poles: np.ndarray) -> list:
+    """The delay cover's gain where it is bounded: on the grid, at its :data:`_PEAKS`
+    largest maxima refined between grid points, and at the loop's resonances
+    (:func:`_resonance_points`), as µ is for robust performance.  On the grid alone the
+    multi-seat design's cover reached µ 0.999 (mixed, dense grid) at 86.6 rad/s between
+    two points of its 200 (2026-11-27)."""
+    curve, top, _ = mu.cover_peaks(K, _PEAKS)
+    return [curve, top, mu.cover_gain(K, _resonance_points(poles))]
 
 
 def _resonance_points(poles: np.ndarray) -> np.ndarray:
@@ -655,9 +678,10 @@ class _Problem:
         with np.errstate(all="ignore"):
             try:
                 pa = self.mu.loop_poles(K)
-                poles = np.concatenate(
-                    [loop_poles(K, s.params) for s in self.seats] + [pa]
-                    + [s.cover.loop_poles(K) for s in self.seats if s.cover is not None])
+                covers = [(s.cover, s.cover.loop_poles(K)) for s in self.seats
+                          if s.cover is not None]
+                poles = np.concatenate([loop_poles(K, s.params) for s in self.seats] + [pa]
+                                       + [pc for _, pc in covers])
             except np.linalg.LinAlgError:
                 return None
             if not np.all(np.isfinite(poles)) or np.max(poles.real) >= 0:
@@ -670,9 +694,9 @@ class _Problem:
                 curve, top, _ = self.mu.peaks(K, _PEAKS)
                 rp = [curve, top, self.mu.curve(K, _resonance_points(pa))]
             else:
-                rp = [self.mu.cover_gain(K)]
-            mu = np.concatenate(rp + [s.cover.cover_gain(K) for s in self.seats
-                                      if s.cover is not None])
+                rp = _cover_points(self.mu, K, pa)
+            mu = np.concatenate(rp + [g for cover, pc in covers
+                                      for g in _cover_points(cover, K, pc)])
         b = self.bounds
         mags = np.sort(np.abs(np.concatenate([poles, np.linalg.eigvals(K.A)])))
         shape = _shape_margins(poles)
