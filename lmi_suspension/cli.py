@@ -312,9 +312,9 @@ def _cmd_occupants(args: argparse.Namespace) -> int:
                 f"{max(c.controller_radius, c.loop_radius):13.0f}")
         if args.mu:
             m = occupant_mu(K, rng=np.random.default_rng(args.seed))
-            row.update(rs_upper=m.rs_upper, rs_lower=m.rs_lower, rp_upper=m.rp_upper,
-                       rp_lower=m.rp_lower)
-            line += (f"  {m.rs_upper:6.3f} ({m.rs_lower:5.3f})  {m.rp_upper:6.3f} "
+            row.update(rs_upper=m.rs_upper, rs_lower=m.rs_lower, rs_sup=m.rs_sup,
+                       rp_upper=m.rp_upper, rp_lower=m.rp_lower, rp_sup=m.rp_sup)
+            line += (f"  {m.rs_sup:6.3f} ({m.rs_lower:5.3f})  {m.rp_sup:6.3f} "
                      f"({m.rp_lower:5.3f})")
         sys.stdout.write(line + "\n")
         fig = plot_occupants(c, S, title=f"{name}: {len(S.performance)} seats × "
@@ -643,8 +643,9 @@ def build_parser() -> argparse.ArgumentParser:
                            "each, mostly its own limit's LP)")
     p_oc.add_argument("--seed", type=int, default=2026, help="seed of the samples")
     p_oc.add_argument("--mu", action="store_true",
-                      help="also mixed µ, robust stability and performance (minutes per "
-                           "controller)")
+                      help="also mixed µ, robust stability and performance: upper bounds "
+                           "over every frequency, lower bounds on the grid (under a "
+                           "minute per controller)")
     p_oc.add_argument("--out", default="occupants_out", help="output folder")
     p_oc.add_argument("-q", "--quiet", action="store_true", help="no progress lines")
     p_oc.set_defaults(func=_cmd_occupants)

@@ -208,6 +208,68 @@ def test_slycot_ab13md_independent_route():
         assert res.upper == pytest.approx(bound, rel=1e-5)
 
 
+def test_ab13md_method_gives_the_documented_bound_with_checked_scalings():
+    """``method="ab13md"``: SLICOT's documented example value, and the returned scalings
+    certify the returned bound (recomputed here with numpy)."""
+    pytest.importorskip("slycot")
+    res = mussv(AB13MD_Z, AB13MD_BLK, method="ab13md")
+    assert res.method == "ab13md"
+    assert res.upper == pytest.approx(AB13MD_BOUND, rel=1e-6)
+    assert lmi_certified_bound(AB13MD_Z, res) <= res.upper * (1 + 1e-9)
+    assert_lower_certified(AB13MD_Z, res)
+
+
+def test_ab13md_method_agrees_with_the_lmi_on_a_mixed_sweep():
+    """Two routes to one D-G bound on a 4-frequency stack with real and complex blocks:
+    AB13MD (SLICOT) and the Clarabel LMI, each certified by its own scalings."""
+    pytest.importorskip("slycot")
+    rng = np.random.default_rng(31)
+    blk = [[-1, 0], [-1, 0], [1, 1], [2, 2]]
+    M = crandn(rng, 5, 5, 4)
+    ab = mussv(M, blk, method="ab13md")
+    lmi = mussv(M, blk, method="lmi")
+    assert ab.upper == pytest.approx(lmi.upper, rel=1e-5)
+    for k in range(4):
+        Mk = M[:, :, k]
+        one = mussv(Mk, blk, method="ab13md")
+        assert lmi_certified_bound(Mk, one) <= one.upper * (1 + 1e-9)
+        assert one.upper == ab.upper[k]
+
+
+def test_ab13md_refuses_structures_it_does_not_take():
+    pytest.importorskip("slycot")
+    rng = np.random.default_rng(32)
+    with pytest.raises(InputError, match="ab13md"):
+        mussv(crandn(rng, 3, 3), [[-2, 0], [1, 1]], method="ab13md")   # repeated real
+    with pytest.raises(InputError, match="ab13md"):
+        mussv(crandn(rng, 3, 2), [[1, 2], [1, 1]], method="ab13md")    # 1 × 2 full block
+
+
+@pytest.mark.parametrize("failure", ["raises", "claims too little"])
+def test_ab13md_failure_falls_back_to_the_lmi(monkeypatch, caplog, failure):
+    """An injected AB13MD failure (an exception, or a value its scalings do not certify)
+    gives the LMI's bound at that frequency, and says so."""
+    slycot = pytest.importorskip("slycot")
+    real = slycot.ab13md
+
+    def broken(Z, nblock, itype, *args):
+        if failure == "raises":
+            raise slycot.exceptions.SlycotArithmeticError("injected", 5)
+        bound, d, g, x = real(Z, nblock, itype, *args)
+        return 0.5 * bound, d, g, x
+
+    monkeypatch.setattr(slycot, "ab13md", broken)
+    rng = np.random.default_rng(33)
+    blk = [[-1, 0], [1, 1], [2, 2]]
+    M = crandn(rng, 4, 4)
+    with caplog.at_level("INFO", logger="lmi_suspension.mu.bounds"):
+        res = mussv(M, blk, method="ab13md")
+    lmi = mussv(M, blk, method="lmi")
+    assert res.upper == pytest.approx(lmi.upper, rel=1e-9)
+    assert lmi_certified_bound(M, res) <= res.upper * (1 + 1e-9)
+    assert "LMI bound was used there" in caplog.text
+
+
 # ------------------------------------------------------------------ real blocks
 def test_single_repeated_real_scalar_is_largest_real_eigenvalue():
     rng = np.random.default_rng(19)

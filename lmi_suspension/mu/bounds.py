@@ -7,6 +7,14 @@ Upper bound (per frequency)
       scaling at the first frequency and from the previous frequency's optimum (and
       inverse Hessian) afterwards.  ``log σ̄(e^X M e^-X)`` is convex in the diagonal
       ``X``, so the local optimum is global.
+    * ``"ab13md"``: the same D-G bound by SLICOT's AB13MD (Fan, Tits and Doyle's own
+      algorithm, through slycot), for structures it accepts: square full complex
+      blocks and single real scalars.  Its scalings are re-checked with numpy like the
+      LMI's (the returned bound is the generalized eigenvalue they certify), and a
+      frequency where AB13MD fails or its scalings do not confirm its value falls back
+      to ``"lmi"``.  On the seat's occupant structure (one complex and seven real
+      scalars, 11 × 11) it agreed with ``"lmi"`` to 1e-6 in 10–20 ms against 3–9 s
+      per frequency (2026-11-27).
     * ``"lmi"``: the exact D (and G, for real blocks) LMI bound of Fan, Tits and
       Doyle (1991): the smallest β with ``M* X_L M + j(G M - M* G*) - β² X_R ⪯ 0``
       for structured ``X = D* D ≻ 0`` and Hermitian ``G``.  One CVXPY problem per
@@ -46,7 +54,10 @@ __all__ = ["MussvOptions", "MussvResult", "MussvTimings", "mussv"]
 
 logger = logging.getLogger(__name__)
 
-_METHODS = ("auto", "fast", "lmi")
+_METHODS = ("auto", "fast", "lmi", "ab13md")
+#: AB13MD's value is taken where the numpy check of its scalings confirms it to this
+#: relative margin (they agreed to 1e-9 on the seat's occupant structure)
+_AB13MD_CONFIRM = 1e-6
 
 
 @dataclass(frozen=True)
@@ -151,7 +162,8 @@ class MussvResult:
     blk : BlockStructure
         The block structure.
     method : str
-        Upper-bound method used: ``"fast"`` or ``"lmi"``.
+        Upper-bound method used: ``"fast"``, ``"lmi"`` or ``"ab13md"`` (with
+        ``"ab13md"``, a frequency it failed at used ``"lmi"``; a warning is logged).
     timings : MussvTimings
         Wall-clock seconds.
     """
@@ -506,6 +518,45 @@ def _certify(M, XL, XR, G):
     return float(np.sqrt(max(lam[-1], 0.0)))
 
 
+def _ab13md_blocks(struct: BlockStructure):
+    """``(nblock, itype)`` of AB13MD for ``struct``, or None where it has a block AB13MD
+    does not take (a non-square full block, a repeated scalar)."""
+    nblock, itype = [], []
+    for b in struct.blocks:
+        if b.kind is BlockKind.FULL and b.rows == b.cols:
+            nblock.append(b.rows)
+            itype.append(2)
+        elif b.rows == 1:           # a single complex or real scalar
+            nblock.append(1)
+            itype.append(1 if b.is_real else 2)
+        else:
+            return None
+    return np.array(nblock, dtype=int), np.array(itype, dtype=int)
+
+
+def _ab13md_upper(M, blocks):
+    """AB13MD's D-G bound of ``M`` with its scalings ``(X, X, G)``, the bound being the
+    one those scalings certify (:func:`_certify`); ``(inf, None)`` where AB13MD fails or
+    the certificate does not confirm its value."""
+    from slycot import ab13md
+
+    try:
+        bound, d, g, _ = ab13md(np.asarray(M, dtype=complex), *blocks)
+    except Exception as exc:        # slycot's arithmetic errors and bad workspace alike
+        logger.info("AB13MD failed (%s); the LMI bound is used", exc)
+        return np.inf, None
+    d, g = np.asarray(d, dtype=float), np.asarray(g, dtype=float)
+    if not (np.all(np.isfinite(d)) and np.all(d > 0) and np.all(np.isfinite(g))):
+        return np.inf, None
+    X, G = np.diag(d ** 2).astype(complex), np.diag(g).astype(complex)
+    certified = _certify(M, X, X, G)
+    if not certified <= bound * (1 + _AB13MD_CONFIRM) + np.finfo(float).tiny:
+        logger.info("AB13MD's scalings certify %.10g, not its %.10g; the LMI bound is used",
+                    certified, bound)
+        return np.inf, None
+    return certified, (X, X, G)
+
+
 def _lmi_upper(M, lmi: _LmiBound, hi, scal_hi, lo, opts: MussvOptions):
     """Exact D-G bound by a sequence of margin problems; returns (bound, scalings, solves).
 
@@ -828,10 +879,13 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
         MATLAB-style rows: ``[r, c]`` full complex ``r × c`` block, ``[r, 0]``
         repeated complex scalar, ``[-r, 0]`` repeated real scalar.  ``M`` must be
         ``(Σ c_i) × (Σ r_i)`` (Δ is ``(Σ r_i) × (Σ c_i)``).
-    method : {"auto", "fast", "lmi"}
+    method : {"auto", "fast", "lmi", "ab13md"}
         Upper-bound method.  ``"auto"`` uses ``"fast"`` when every block is full
         complex and ``"lmi"`` otherwise; ``"fast"`` on other structures raises
-        :class:`~lmi_suspension.errors.InputError`.
+        :class:`~lmi_suspension.errors.InputError`.  ``"ab13md"`` computes the D-G
+        bound with SLICOT (square full blocks and single scalars only; a frequency
+        where it fails its certificate falls back to ``"lmi"``), two orders of
+        magnitude faster on mixed structures.
     omega : array_like, optional
         Frequencies (rad/s) of a stack, carried into the result.
     rng : numpy.random.Generator, optional
@@ -879,7 +933,16 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
             "method='fast' needs full complex blocks only (scalar-identity D); "
             f"structure {struct.to_blk().tolist()} has repeated scalar blocks: use 'lmi' or 'auto'"
         )
-    use = "fast" if (method == "fast" or (method == "auto" and fast_ok)) else "lmi"
+    ab_blocks = None
+    if method == "ab13md":
+        ab_blocks = _ab13md_blocks(struct)
+        if ab_blocks is None or struct.n_in != struct.n_out:
+            raise InputError(
+                "method='ab13md' needs square full blocks and single (1 x 1) scalars; "
+                f"structure {struct.to_blk().tolist()} has another: use 'lmi' or 'auto'")
+    use = "fast" if (method == "fast" or (method == "auto" and fast_ok)) else (
+        "ab13md" if method == "ab13md" else "lmi")
+    fallbacks = 0
 
     nout, nin, nf = stack.shape
     m = struct.n_blocks
@@ -910,7 +973,7 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
             continue
         # ---------------- fast upper bound (also the LMI's starting point)
         t0 = time.perf_counter()
-        perron = _perron_logd(Mk, struct, rl, cl) if (x_prev is None or use == "lmi") else None
+        perron = _perron_logd(Mk, struct, rl, cl) if (x_prev is None or use != "fast") else None
         ub_fast, logd = None, None
         if fast_ok and (use == "fast" or opts.lmi_warm_start):
             # Warm start from the previous frequency; Perron only to begin a sweep.
@@ -944,6 +1007,9 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
             dl, dr = struct.d_scalings(list(d))
             XL, XR, Gk = dl @ dl, dr @ dr, np.zeros((nin, nout))
         else:
+            ub, scal = (np.inf, None) if ab_blocks is None else _ab13md_upper(Mk, ab_blocks)
+            fallbacks += ab_blocks is not None and scal is None
+        if use != "fast" and scal is None:
             if lmi is None:
                 lmi = _LmiBound(struct, opts)
             d0 = np.exp(perron)
@@ -957,6 +1023,7 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
                 cand.append((ub_fast, (dlf @ dlf, drf @ drf, None)))
             hi, scal_hi = min(cand, key=lambda c: c[0])
             ub, scal, _ = _lmi_upper(Mk, lmi, hi, scal_hi, lo_val, opts)
+        if use != "fast":
             XL, XR, Gk = scal
             if Gk is None:
                 Gk = np.zeros((nin, nout))
@@ -993,6 +1060,9 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
         delta = np.moveaxis(dlt, 0, -1)
         t_lo += time.perf_counter() - t0
 
+    if fallbacks:
+        logger.warning("mussv: AB13MD gave no certified bound at %d of %d frequencies; "
+                       "the LMI bound was used there", fallbacks, nf)
     ipk = int(np.argmax(upper))
     peak = float(upper[ipk])
     peak_omega = None if omega is None else float(omega[ipk])

@@ -206,7 +206,8 @@ def interval_bound(CL, mu, omega, *, rtol: float = 1e-3,
     Each interval between and beyond the grid points is checked at the level
     ``(1 + rtol)`` times the peak of the pointwise bounds, with the scalings of one of
     its end points.  An interval that does not pass is split at its (logarithmic)
-    midpoint, where µ is bounded anew (``mussv``'s LMI bound), until its halves pass or
+    midpoint, where µ is bounded anew (``mussv``'s LMI bound, or AB13MD's where ``mu``
+    was computed with it), until its halves pass or
     ``max_splits`` splits are spent; an interval that still does not pass gets its own
     level, raised until it does.
 
@@ -251,6 +252,9 @@ def interval_bound(CL, mu, omega, *, rtol: float = 1e-3,
     """
     from .bounds import MussvOptions, mussv
 
+    # a split point is bounded by the grid's route where that was SLICOT's (the same
+    # D-G bound), by the LMI otherwise (it takes every structure)
+    method = "ab13md" if mu.method == "ab13md" else "lmi"
     omega = np.asarray(omega, dtype=float).ravel()
     loop = _Loop(CL)
     upper = np.asarray(mu.upper, dtype=float).ravel()
@@ -261,7 +265,7 @@ def interval_bound(CL, mu, omega, *, rtol: float = 1e-3,
 
     def split(a: float, b: float) -> float:
         w = float(np.sqrt(a * b)) if a > 0 and np.isfinite(b) else (b / 10 if a == 0 else 10 * a)
-        at = mussv(loop.response(w)[:, :, None], mu.blk, method="lmi", omega=np.array([w]),
+        at = mussv(loop.response(w)[:, :, None], mu.blk, method=method, omega=np.array([w]),
                    options=MussvOptions(compute_lower=False))
         points[w] = (max(float(np.ravel(at.upper)[0]), 0.0), _scalings(at, 0))
         return w
