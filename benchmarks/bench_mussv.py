@@ -10,6 +10,9 @@ with 3 full complex blocks, 4×4 (blk [[2,2],[1,1],[1,1]]) and 8×8
 (blk [[4,4],[2,2],[2,2]]), at 61 and 500 log-spaced frequencies in [1e-2, 1e2] rad/s.
 Each benchmark records in ``extra_info`` the largest relative deviation of its upper
 bound from the exact LMI value (``mussv(method="lmi", lmi_warm_start=False)``).
+
+Mixed real/complex (``test_mussv_mixed_upper``): a 5 × 5 system of the same kind with
+blk [[-1,0],[-1,0],[1,1],[2,2]] at 61 frequencies, SLICOT's AB13MD against the LMI.
 """
 
 from __future__ import annotations
@@ -99,3 +102,44 @@ def test_dkpy_ssv_lmi_bisection(benchmark, size, nf):
     mu, *_ = benchmark.pedantic(run, rounds=1, iterations=1)
     dev = float(np.max(np.abs(np.asarray(mu).ravel() / exact(size, nf) - 1)))
     benchmark.extra_info.update(max_rel_dev_vs_lmi=dev)
+
+
+# ------------------------------------------------------------------ mixed real / complex
+#: a mixed structure AB13MD takes: two real scalars, a 1 × 1 and a 2 × 2 complex block
+MIXED = [[-1, 0], [-1, 0], [1, 1], [2, 2]]
+
+
+@functools.lru_cache(maxsize=None)
+def mixed_problem(nf: int):
+    """Seeded stable random 5 × 5 system on nf frequencies (rad/s)."""
+    rng = np.random.default_rng(2031)
+    A = rng.standard_normal((6, 6))
+    A -= (np.max(np.linalg.eigvals(A).real) + 0.5) * np.eye(6)
+    sys = control.ss(A, rng.standard_normal((6, 5)), rng.standard_normal((5, 6)),
+                     0.3 * rng.standard_normal((5, 5)))
+    w = np.logspace(-2, 2, nf)
+    return sys(1j * w), w
+
+
+@functools.lru_cache(maxsize=None)
+def mixed_lmi(nf: int):
+    M, w = mixed_problem(nf)
+    return mussv(M, MIXED, omega=w, method="lmi", options=LMI_COLD).upper
+
+
+@pytest.mark.parametrize("method", ["ab13md", "lmi"])
+def test_mussv_mixed_upper(benchmark, method):
+    """Mixed real/complex upper bound, SLICOT's AB13MD against the Clarabel LMI (61
+    frequencies); ``extra_info`` holds the largest ratio of its bound to the LMI's (the
+    smaller, the tighter)."""
+    pytest.importorskip("slycot")
+    M, w = mixed_problem(61)
+    res = benchmark.pedantic(mussv, args=(M, MIXED),
+                             kwargs=dict(omega=w, method=method, options=LMI_COLD),
+                             rounds=3 if method == "ab13md" else 1, iterations=1)
+    ratio = res.upper / mixed_lmi(61)
+    benchmark.extra_info.update(max_ratio_vs_lmi=float(np.max(ratio)),
+                                min_ratio_vs_lmi=float(np.min(ratio)),
+                                upper_seconds=res.timings.upper)
+    # both are the D-G bound, each certified by its scalings: AB13MD is never looser
+    assert np.max(ratio) <= 1 + 1e-5

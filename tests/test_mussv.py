@@ -188,7 +188,7 @@ AB13MD_BOUND = 41.74753408
 
 
 def test_slicot_ab13md_example():
-    res = mussv(AB13MD_Z, AB13MD_BLK)
+    res = mussv(AB13MD_Z, AB13MD_BLK, method="lmi")
     assert res.method == "lmi"
     assert res.upper == pytest.approx(AB13MD_BOUND, rel=1e-6)
     assert lmi_certified_bound(AB13MD_Z, res) <= res.upper * (1 + 1e-9)
@@ -204,8 +204,9 @@ def test_slycot_ab13md_independent_route():
         (crandn(rng, 4, 4), [1, 2, 1], [2, 2, 1], [[1, 1], [2, 2], [-1, 0]]),
     ]:
         bound, *_ = slycot.ab13md(Z, np.array(nblock), np.array(itype))
-        res = mussv(Z, blk)
+        res = mussv(Z, blk, method="lmi")
         assert res.upper == pytest.approx(bound, rel=1e-5)
+        assert mussv(Z, blk).method == "ab13md"      # what "auto" takes here
 
 
 def test_ab13md_method_gives_the_documented_bound_with_checked_scalings():
