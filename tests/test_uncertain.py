@@ -24,11 +24,10 @@ import pytest
 from lmi_suspension.errors import AssumptionError, NonFiniteError, ParameterError
 from lmi_suspension.lti import hinfnorm
 from lmi_suspension.lti.norms import freqresp
-from lmi_suspension.uncertain import (USS, connect, feedback, lftdata, nominal, robstab, ucomplex,
+from lmi_suspension.uncertain import (connect, feedback, lftdata, nominal, robstab, ucomplex,
                                       ultidyn, ureal, usample, uss, usubs, wcgain)
-from uncertain_plants import (PLANTS, THIRD_MARGIN, brute_margin, brute_wcgain, lag_loop_direct,
-                              lag_loop_uncertain, physical, third_uncertain, two_mass_direct,
-                              two_mass_uncertain)
+from uncertain_plants import (PLANTS, THIRD_MARGIN, brute_margin, brute_wcgain,
+                              lag_loop_uncertain, physical, third_uncertain)
 
 S_POINTS = [0.0, 0.3j, 1j, 2.5j, 1 + 2j, 10j]
 W60 = np.logspace(-2, 2, 60)
