@@ -237,6 +237,22 @@ def test_ab13md_method_agrees_with_the_lmi_on_a_mixed_sweep():
         assert one.upper == ab.upper[k]
 
 
+def test_ab13md_block_map_takes_only_square_full_blocks_and_single_scalars():
+    from lmi_suspension.mu.bounds import _ab13md_blocks
+
+    nblock, itype = _ab13md_blocks(BlockStructure.coerce([[-1, 0], [1, 0], [2, 2]]))
+    assert nblock.tolist() == [1, 1, 2] and itype.tolist() == [1, 2, 2]
+    assert _ab13md_blocks(BlockStructure.coerce([[1, 2], [2, 1]])) is None   # 1 x 2 full
+    assert _ab13md_blocks(BlockStructure.coerce([[-2, 0], [1, 1]])) is None  # repeated
+    assert _ab13md_blocks(BlockStructure.coerce([[2, 0], [1, 1]])) is None   # repeated
+
+
+def test_auto_leaves_a_lone_real_scalar_to_the_lmi():
+    """µ of one real scalar is 0 where M has no real eigenvalue, which no finite
+    scaling certifies: "auto" keeps the LMI (and the exact lower bound) there."""
+    assert mussv(np.array([[1 + 1j]]), [[-1, 0]]).method == "lmi"
+
+
 def test_ab13md_refuses_structures_it_does_not_take():
     pytest.importorskip("slycot")
     rng = np.random.default_rng(32)
@@ -246,10 +262,11 @@ def test_ab13md_refuses_structures_it_does_not_take():
         mussv(crandn(rng, 3, 2), [[1, 2], [1, 1]], method="ab13md")    # 1 × 2 full block
 
 
-@pytest.mark.parametrize("failure", ["raises", "claims too little"])
+@pytest.mark.parametrize("failure", ["raises", "claims too little", "D varies in a block"])
 def test_ab13md_failure_falls_back_to_the_lmi(monkeypatch, caplog, failure):
-    """An injected AB13MD failure (an exception, or a value its scalings do not certify)
-    gives the LMI's bound at that frequency, and says so."""
+    """An injected AB13MD failure (an exception, a value its scalings do not certify, or
+    scalings outside the structure) gives the LMI's bound at that frequency, and says
+    so."""
     slycot = pytest.importorskip("slycot")
     real = slycot.ab13md
 
@@ -257,6 +274,12 @@ def test_ab13md_failure_falls_back_to_the_lmi(monkeypatch, caplog, failure):
         if failure == "raises":
             raise slycot.exceptions.SlycotArithmeticError("injected", 5)
         bound, d, g, x = real(Z, nblock, itype, *args)
+        if failure == "D varies in a block":
+            d = np.array(d, dtype=float)
+            # inside the 2 x 2 full block (rows 2 and 3), too little for the
+            # certificate to notice: only the structure check refuses it
+            d[2] *= 1.0 + 1e-7
+            return bound, d, g, x
         return 0.5 * bound, d, g, x
 
     monkeypatch.setattr(slycot, "ab13md", broken)

@@ -275,7 +275,7 @@ def test_cover_peaks_find_the_resonance_a_coarse_grid_steps_over():
     curve, top, w = TwoBlockMu(DEFAULT_DESIGN, np.logspace(-1, 3, 9), p).cover_peaks(K, 3)
     assert top.shape == w.shape == (3,)
     assert np.max(curve) < 0.5 * dense
-    assert dense * 0.98 <= np.max(top) <= dense * (1 + 1e-9)
+    assert dense * 0.98 <= np.max(top) <= dense * (1 + 1e-5)
     assert 60 < w[np.argmax(top)] < 100
 
 
@@ -322,7 +322,8 @@ def test_without_performance_mu_the_design_seat_asks_robust_stability_only(monke
     # 1e-3 of) a 20 001-point grid's over the decades where the cover's gain peaks
     dense = np.max(np.abs(freqresp(CL, np.logspace(0, 3, 20001))[0, 0, :]))
     assert on_grid < dense * (1 - 3e-3)
-    assert on_grid * (1 - 1e-12) <= d.mu <= dense * (1 + 1e-9)
+    # (a refined maximum may pass a finite grid's by the grid's own resolution)
+    assert on_grid * (1 - 1e-12) <= d.mu <= dense * (1 + 1e-5)
     assert d.mu >= dense * (1 - 1e-3)
     assert np.max(TwoBlockMu(DEFAULT_DESIGN, grid).curve(d.K)) > d.mu
     with pytest.raises(ParameterError, match="mu_performance"):

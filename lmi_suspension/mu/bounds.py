@@ -529,7 +529,7 @@ def _ab13md_blocks(struct: BlockStructure):
         if b.kind is BlockKind.FULL and b.rows == b.cols:
             nblock.append(b.rows)
             itype.append(2)
-        elif b.rows == 1:           # a single complex or real scalar
+        elif b.is_scalar and b.rows == 1:       # a single complex or real scalar
             nblock.append(1)
             itype.append(1 if b.is_real else 2)
         else:
@@ -540,17 +540,29 @@ def _ab13md_blocks(struct: BlockStructure):
 def _ab13md_upper(M, blocks):
     """AB13MD's D-G bound of ``M`` with its scalings ``(X, X, G)``, the bound being the
     one those scalings certify (:func:`_certify`); ``(inf, None)`` where AB13MD fails or
-    the certificate does not confirm its value."""
+    the certificate does not confirm its value.
+
+    The certificate holds for the structure only if ``D`` is one scalar on each full
+    block and ``G`` is zero outside the real scalars: ``G`` is zeroed there and a ``D``
+    that varies inside a block is refused, so that the bound never rests on AB13MD's
+    word for the structure."""
     from slycot import ab13md
 
+    nblock, itype = blocks
     try:
-        bound, d, g, _ = ab13md(np.asarray(M, dtype=complex), *blocks)
+        bound, d, g, _ = ab13md(np.asarray(M, dtype=complex), nblock, itype)
     except Exception as exc:        # slycot's arithmetic errors and bad workspace alike
         logger.info("AB13MD failed (%s); the LMI bound is used", exc)
         return np.inf, None
     d, g = np.asarray(d, dtype=float), np.asarray(g, dtype=float)
     if not (np.all(np.isfinite(d)) and np.all(d > 0) and np.all(np.isfinite(g))):
         return np.inf, None
+    ends = np.cumsum(nblock)
+    for start, stop in zip(ends - nblock, ends):
+        if np.ptp(d[start:stop]) > 1e-9 * np.max(d[start:stop]):
+            logger.info("AB13MD's D varies inside a block; the LMI bound is used")
+            return np.inf, None
+    g = np.where(np.repeat(itype == 1, nblock), g, 0.0)
     X, G = np.diag(d ** 2).astype(complex), np.diag(g).astype(complex)
     certified = _certify(M, X, X, G)
     if not certified <= bound * (1 + _AB13MD_CONFIRM) + np.finfo(float).tiny:
@@ -939,7 +951,10 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
             f"structure {struct.to_blk().tolist()} has repeated scalar blocks: use 'lmi' or 'auto'"
         )
     ab_blocks = None
-    if method == "ab13md" or (method == "auto" and not fast_ok):
+    lone_real = struct.n_blocks == 1 and struct.blocks[0].is_real
+    # a lone real scalar has its own exact lower bound and µ can be 0 there, which no
+    # finite scaling certifies: "auto" leaves it to the LMI
+    if method == "ab13md" or (method == "auto" and not fast_ok and not lone_real):
         ab_blocks = _ab13md_blocks(struct) if struct.n_in == struct.n_out else None
         if ab_blocks is None and method == "ab13md":
             raise InputError(
@@ -968,7 +983,6 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
     batch = opts.compute_lower and use == "fast"
     full_idx = [i for i, b in enumerate(struct.blocks) if b.kind is BlockKind.FULL]
     ref = full_idx[-1] if full_idx else m - 1
-    lone_real = m == 1 and struct.blocks[0].is_real
 
     for k in range(nf):
         Mk = stack[:, :, k]
@@ -1066,8 +1080,9 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
         t_lo += time.perf_counter() - t0
 
     if fallbacks:
-        logger.warning("mussv: AB13MD gave no certified bound at %d of %d frequencies; "
-                       "the LMI bound was used there", fallbacks, nf)
+        # the result is the LMI's there, certified as ever: nothing for the caller to mend
+        logger.info("mussv: AB13MD gave no certified bound at %d of %d frequencies; "
+                    "the LMI bound was used there", fallbacks, nf)
     ipk = int(np.argmax(upper))
     peak = float(upper[ipk])
     peak_omega = None if omega is None else float(omega[ipk])

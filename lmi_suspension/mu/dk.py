@@ -421,7 +421,7 @@ def _final_bounds(CL, struct: BlockStructure, omega: np.ndarray, rng):
 
     M = freqresp(CL, omega)
     mu = mussv(M, struct, omega=omega, rng=rng)
-    if mu.method == "lmi":
+    if mu.method != "fast":         # the LMI's or AB13MD's: the D-G bound already
         return mu
     upper, fields = np.array(mu.upper), {k: np.array(getattr(mu, k)) for k in
                                          ("D_left", "D_right", "G", "d_blocks")}

@@ -56,7 +56,7 @@ _MAX_ITER = 30
 #: log-spaced interior points at which each interval is also sampled: the backstop for
 #: crossings that roundoff moves off the imaginary axis (see the module docstring)
 _INTERIOR = 3
-#: default bound on the intervals split per call (each split is one LMI µ bound at its
+#: default bound on the intervals split per call (each split is one µ bound at its
 #: midpoint, 0.05-0.1 s on 3-block structures)
 _MAX_SPLITS = 100
 #: eigenvalues this close to the axis (relative) are probed directly, as in hinfnorm
@@ -77,7 +77,7 @@ class IntervalBound:
     edges : numpy.ndarray
         ``[0, ω_1, ..., inf]``: the grid and the points where intervals were split.
     splits : int
-        Number of intervals split (each costs one LMI bound).
+        Number of intervals split (each costs one µ bound, LMI or AB13MD).
     """
 
     bound: float
@@ -228,7 +228,7 @@ def interval_bound(CL, mu, omega, *, rtol: float = 1e-3,
     rtol : float
         Slack of the certified level over the peak of the pointwise bounds.
     max_splits : int, optional
-        Bound on the intervals split (each one LMI µ bound); default
+        Bound on the intervals split (each one µ bound); default
         :data:`_MAX_SPLITS`.
 
     Returns

@@ -432,10 +432,10 @@ def occupant_mu(K, occupants: OccupantSet | None = None, *, design=None, omega=N
                 rng: np.random.Generator) -> MixedMuCheck:
     """Mixed real/complex µ of ``K`` over the set: the parameters as real scalars, the
     delay cover and performance block of ``design`` (:data:`~.design.DEFAULT_DESIGN` by
-    default) complex; upper bounds by SLICOT's AB13MD (``mussv(method="ab13md")``: the
-    D-G bound, its scalings checked, the LMI where it fails) on the grid and over every
-    frequency (:func:`~lmi_suspension.mu.interval_bound`), lower bounds of ``mussv``'s
-    power iteration.
+    default) complex; upper bounds of :func:`~lmi_suspension.mu.mussv` (SLICOT's AB13MD
+    on the default structure, its scalings checked; the LMI where a design has blocks
+    AB13MD does not take) on the grid and over every frequency
+    (:func:`~lmi_suspension.mu.interval_bound`), lower bounds of its power iteration.
 
     Parameters
     ----------
@@ -465,8 +465,10 @@ def occupant_mu(K, occupants: OccupantSet | None = None, *, design=None, omega=N
     blk = np.asarray(aug.blk)
     # Δ_perf is blk[-1, 0] × blk[-1, 1]: M's last blk[-1, 1] rows and blk[-1, 0] columns
     rows, cols = int(blk[-1, 1]), int(blk[-1, 0])
-    rs = mussv(M[:-rows, :-cols], blk[:-1], method="ab13md", omega=omega, rng=rng)
-    rp = mussv(M, blk, method="ab13md", omega=omega, rng=rng)
+    # "auto": AB13MD on the occupant structure; the LMI where a design's blocks are
+    # ones AB13MD does not take (the paper's non-square norm-bounded blocks)
+    rs = mussv(M[:-rows, :-cols], blk[:-1], omega=omega, rng=rng)
+    rp = mussv(M, blk, omega=omega, rng=rng)
     rs_sup = interval_bound(CL[:CL.noutputs - rows, :CL.ninputs - cols], rs, omega)
     rp_sup = interval_bound(CL, rp, omega)
     rsu, rpu = np.asarray(rs.upper), np.asarray(rp.upper)

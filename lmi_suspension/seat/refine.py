@@ -510,10 +510,12 @@ class RefineOptions:
     z_bound : float
         ``|x1|`` on the road, m, at every delay.
     mu_max : float
-        µ over the delay cover and the performance block, on the search grid; below 1
-        by a margin, for the certificate on a denser grid.  With ``plants``, also the
+        µ over the delay cover and the performance block, on the search grid, at its
+        largest maxima refined between grid points and at the loop's resonances; below
+        1 by a margin, for the certificate on a denser grid.  With ``plants``, also the
         delay cover's gain at each plant; with ``mu_performance=False``, that gain alone
-        at the design seat (on the grid only: a certificate needs a denser one).
+        at the design seat (each gain on the grid, at its refined maxima and at the
+        resonances, as µ).
     disk_radius : float
         Controller and loop poles inside ``|s| < disk_radius``, rad/s (1 kHz: Nyquist
         rate π · 1000 ≈ 3142 rad/s).
@@ -760,8 +762,9 @@ class RefinedDesign:
         the worst over the seats of peak over own limit), commanded ``|u|`` (N),
         ``|x1|`` (m), linear loop on the road (the worst over the seats).
     mu : float
-        µ peak on the search grid (with ``options.plants``: or the largest delay-cover
-        gain at a plant, if larger).
+        µ peak on the search grid, its refined maxima and the resonances (with
+        ``options.plants`` or ``mu_performance=False``: or the largest delay-cover gain,
+        evaluated at the same kinds of points, if larger).
     radius : float
         Largest controller or loop pole magnitude, rad/s.
     met : bool
