@@ -479,12 +479,15 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     runs: dict[str, dict[str, dict[float, object]]] = {"bump": {}, "noise": {}}
     per_ctrl: dict[str, dict] = {}
     summaries = []
-    metrics_of: dict[int, dict] = {}  # passive runs are shared between delays (all kept alive)
+    # passive runs are shared between delays; each entry holds its result, so that no id
+    # is reused by a later result while its entry lives (the sampled runs are not kept
+    # elsewhere: a freed one's id, reused, once gave a loop another loop's figures)
+    metrics_of: dict[int, tuple] = {}
 
     def metrics(res):
         if id(res) not in metrics_of:
-            metrics_of[id(res)] = dataclasses.asdict(res.metrics())
-        return dict(metrics_of[id(res)])
+            metrics_of[id(res)] = (res, dataclasses.asdict(res.metrics()))
+        return dict(metrics_of[id(res)][1])
 
     def bump_value(row, key):
         return row["bump"][key] if row["bump"]["stable"] else math.nan
