@@ -9,7 +9,7 @@ Upper bound (per frequency)
       ``X``, so the local optimum is global.
     * ``"ab13md"``: the same D-G bound by SLICOT's AB13MD (Fan, Tits and Doyle's own
       algorithm, through slycot), for structures it accepts: square full complex
-      blocks and single real scalars.  Its scalings are re-checked with numpy like the
+      blocks and single real or complex scalars.  Its scalings are re-checked with numpy like the
       LMI's (the returned bound is the generalized eigenvalue they certify), and a
       frequency where AB13MD fails or its scalings do not confirm its value falls back
       to ``"lmi"``.  On the seat's occupant structure (one complex and seven real
@@ -166,7 +166,7 @@ class MussvResult:
         The block structure.
     method : str
         Upper-bound method used: ``"fast"``, ``"lmi"`` or ``"ab13md"`` (with
-        ``"ab13md"``, a frequency it failed at used ``"lmi"``; a warning is logged).
+        ``"ab13md"``, a frequency it failed at used ``"lmi"``; the log says so at INFO).
     timings : MussvTimings
         Wall-clock seconds.
     """
