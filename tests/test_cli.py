@@ -188,3 +188,11 @@ def test_refine_for_occupants_needs_an_output_file(capsys):
         main(["refine", "--occupants", "--max-iter", "1"])
     assert exc.value.code == 2
     assert "--out" in capsys.readouterr().err
+
+
+def test_no_set_mu_needs_the_occupants_route(capsys):
+    """``--no-set-mu`` only means something with ``--occupants``: refused, not ignored."""
+    with pytest.raises(SystemExit) as exc:
+        main(["refine", "--no-set-mu", "--max-iter", "1", "--out", "x.json"])
+    assert exc.value.code == 2
+    assert "--occupants" in capsys.readouterr().err

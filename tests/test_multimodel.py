@@ -72,7 +72,7 @@ def test_shipped_multiseat_design_is_stable_on_sampled_seats_and_meets_its_seats
     from lmi_suspension.seat.simulate import simulate
 
     K, Kd, meta = load_refined(SHIPPED_OCCUPANTS)
-    assert meta["met"] is True and len(meta["plants"]) == 9 and Kd.dt == 1e-3
+    assert meta["met"] is True and len(meta["plants"]) == 10 and Kd.dt == 1e-3
     occupants = OccupantSet()
     seats, delays = occupants.sample(300, np.random.default_rng(11))
     S = OccupantSamples(occupants=occupants, stability=seats, stability_delays=delays,

@@ -8,6 +8,8 @@ the time-stepping simulation and the limit LP for the frequency-domain road figu
 ``mussv`` on the closed loop built by python-control for the mixed µ.
 """
 
+from pathlib import Path
+
 import control
 import numpy as np
 import pytest
@@ -18,10 +20,11 @@ from lmi_suspension.mu import mussv
 from lmi_suspension.seat.augmented import seat_augmented_plant
 from lmi_suspension.seat.design import design_mu_controller
 from lmi_suspension.seat.limit import bump_limit
-from lmi_suspension.seat.occupants import (OccupantSamples, OccupantSet, certify_occupants,
-                                           occupant_mu, occupant_samples)
+from lmi_suspension.seat.design import DEFAULT_DESIGN
+from lmi_suspension.seat.occupants import (MixedRsBound, OccupantSamples, OccupantSet,
+                                           certify_occupants, occupant_mu, occupant_samples)
 from lmi_suspension.seat.params import SeatParameters
-from lmi_suspension.seat.refine import load_refined, loop_poles
+from lmi_suspension.seat.refine import TwoBlockMu, load_refined, loop_poles
 from lmi_suspension.seat.roads import bump
 from lmi_suspension.seat.simulate import simulate
 
@@ -223,6 +226,54 @@ def test_mixed_mu_over_every_frequency_bounds_a_dense_grid(K_refined):
     pointwise = [slycot.ab13md(M[:, :, k], nblock, itype)[0] for k in range(dense.size)]
     assert max(pointwise) <= m.rs_sup * (1 + 1e-3)
     assert m.rs_sup < 1.0
+
+
+@pytest.fixture(scope="module")
+def K_multiseat_v1():
+    """The first multi-seat design (shipped until the set's mixed µ entered the design):
+    its robust-stability lower bound is above 1 near 84 rad/s."""
+    return load_refined(Path(__file__).parent / "data" / "multiseat_v1.json")[0]
+
+
+def test_the_lower_bounds_seat_is_one_the_delay_cover_destabilises(K_multiseat_v1):
+    """``rs_worst`` maps the lower bound's real scalars to a seat of the set.  The first
+    multi-seat design's lower bound is above 1 near 84 rad/s (1.043 on this grid,
+    2026-11-27), so its perturbation lies inside the set: at that seat the delay cover
+    alone, in a loop built from the seat's own model with no parametric LFT
+    (``TwoBlockMu``), must have gain equal to the lower bound (one singular
+    perturbation read by two realizations; they agreed to 1e-7) and above 1."""
+    s = OccupantSet()
+    m = occupant_mu(K_multiseat_v1, s, omega=np.linspace(78.0, 90.0, 25),
+                    rng=np.random.default_rng(0))
+    assert m.rs_lower > 1.0 and m.rs_worst is not None
+    for name, lo, hi in s.ranges():
+        assert lo * (1 - 1e-9) <= getattr(m.rs_worst, name) <= hi * (1 + 1e-9)
+    gain = TwoBlockMu(DEFAULT_DESIGN, np.array([1.0, 2.0]), m.rs_worst).cover_gain(
+        K_multiseat_v1, [m.rs_worst_omega])
+    assert gain[0] == pytest.approx(m.rs_lower, rel=1e-5)
+
+
+def test_fixed_scalings_bound_the_mu_of_another_controller(K_refined, K_multiseat_v1):
+    """``MixedRsBound``: the levels at the scalings' own controller are the bounds they
+    were found for; its extra points (where ``interval_bound`` split) hold a peak the
+    40-point grid misses; and the same scalings bound µ of *another* controller at every
+    frequency (any admissible scaling does): they are never below the D-G bound SLICOT's
+    AB13MD optimises for that controller, called directly on the loop built by
+    python-control (AB13MD's own tolerance, 1e-6, as slack)."""
+    slycot = pytest.importorskip("slycot")
+    rs = MixedRsBound(omega=np.logspace(0.5, 3.0, 40))
+    scal = rs.scalings(K_multiseat_v1)
+    extra = rs.omega.size
+    assert scal.omega.size == extra + 6
+    assert rs.levels(K_multiseat_v1, scal) == pytest.approx(scal.upper, rel=1e-9)
+    assert np.max(scal.upper[extra:]) > np.max(scal.upper[:extra])
+    assert scal.sup >= np.max(scal.upper) * (1 - 1e-9)
+    aug = seat_augmented_plant(OccupantSet().mu_design(), OccupantSet().nominal)
+    M = freqresp(lft(aug.P, K_refined, aug.nmeas, aug.ncon), scal.omega)[:-3, :-3]
+    nblock, itype = np.array([1] * 8), np.array([2] + [1] * 7)
+    optimised = np.array([slycot.ab13md(M[:, :, k], nblock, itype)[0]
+                          for k in range(scal.omega.size)])
+    assert np.all(rs.levels(K_refined, scal) >= optimised * (1 - 1e-6))
 
 
 def test_the_map_draws_every_sample_and_marks_the_unstable():

@@ -125,7 +125,7 @@ def test_an_unstable_start_raises():
 
 
 @pytest.mark.parametrize("field,value", [("u_bound", 0.0), ("mu_max", np.nan),
-                                         ("max_iter", 0)])
+                                         ("max_iter", 0), ("occupants", "every seat")])
 def test_bad_options_raise(field, value):
     with pytest.raises(ParameterError):
         RefineOptions(**{field: value})
@@ -147,6 +147,38 @@ def test_a_worse_stage_is_rejected_and_the_box_halved(K_mu, monkeypatch):
     assert [s.trust for s in d.stages] == [refine._TRUST_START / 2, refine._TRUST_START / 4]
     start = modal_form(K_mu, 1900.0)
     assert np.allclose(d.K.B, start.B) and np.allclose(d.K.D, start.D)
+
+
+def test_the_sets_robust_stability_enters_every_stage(monkeypatch):
+    """With ``occupants``, the set's mixed-µ bound is a requirement: injected, SLSQP
+    returns its start, so both stages are rejected and the controller stays the first
+    multi-seat design (``tests/data/multiseat_v1.json``), whose robust stability over
+    the set the search must then report as µ, not the delay cover's gain (0.97 at its
+    seats).  The scalings are optimised for the start (``rs_sup`` of each stage, against
+    ``MixedRsBound`` called here: 1.048 over every frequency, 2026-11-27) and for the
+    returned controller after the last stage (the result's ``rs_sup``)."""
+    from pathlib import Path
+    from types import SimpleNamespace
+
+    from lmi_suspension.seat.occupants import MixedRsBound, OccupantSet
+
+    def still(z0, grad, bounds, constraints, maxiter):
+        return SimpleNamespace(x=np.array(z0, dtype=float), nit=1, success=False)
+
+    monkeypatch.setattr(refine, "_slsqp", still)
+    s = OccupantSet()
+    K0 = load_refined(Path(__file__).parent / "data" / "multiseat_v1.json")[0]
+    d = refine_seat_controller(K0, RefineOptions(max_iter=2, mu_performance=False,
+                                                 occupants=s), params=s.nominal)
+    assert [st.accepted for st in d.stages] == [False, False]
+    start = modal_form(K0, 1900.0)
+    scal = MixedRsBound(s).scalings(start)
+    assert d.mu == pytest.approx(np.max(scal.upper), rel=1e-6)
+    assert [st.rs_sup for st in d.stages] == pytest.approx([scal.sup] * 2, rel=1e-6)
+    assert d.rs_sup == pytest.approx(scal.sup, rel=1e-6)
+    assert d.mu > 1.0 and not d.met
+    for a, b in ((d.K.A, start.A), (d.K.B, start.B), (d.K.C, start.C), (d.K.D, start.D)):
+        assert np.allclose(a, b, rtol=1e-12, atol=0)
 
 
 def test_a_short_search_lowers_the_violation(K_mu, monkeypatch):
@@ -260,14 +292,16 @@ def test_cover_gain_is_the_delay_channels_largest_singular_value(K_mu):
 
 
 def test_cover_peaks_find_the_resonance_a_coarse_grid_steps_over():
-    """On 9 points over 0.1–1000 rad/s the grid reads the multi-seat design's delay
-    cover at less than half its peak (near 79 rad/s); the refined maxima reach the peak
-    of a 20 001-point grid of σ̄ of the LFT's delay channel (another route) within 2 %,
-    and never exceed it."""
-    from lmi_suspension.seat.multimodel import SHIPPED_OCCUPANTS
+    """On 9 points over 0.1–1000 rad/s the grid reads the first multi-seat design's
+    delay cover (``tests/data/multiseat_v1.json``, shipped until the set's mixed µ
+    entered the design) at less than half its peak (near 79 rad/s); the refined maxima
+    reach the peak of a 20 001-point grid of σ̄ of the LFT's delay channel (another
+    route) within 2 %, and never exceed it."""
+    from pathlib import Path
+
     from lmi_suspension.seat.params import SeatParameters
 
-    K = load_refined(SHIPPED_OCCUPANTS)[0]
+    K = load_refined(Path(__file__).parent / "data" / "multiseat_v1.json")[0]
     p = SeatParameters(m3=70.0, k1=24800.0)
     aug = seat_augmented_plant(DEFAULT_DESIGN, p)
     dense = np.max(np.abs(freqresp(lft(aug.P, K, aug.nmeas, aug.ncon),

@@ -18,7 +18,13 @@ take part in any design of this package:
   delay) and the larger of the two figures reported;
 * **mixed µ** (:func:`occupant_mu`): the set's parameters as real scalars with the
   design's delay cover, robust stability and robust performance, upper and lower bounds
-  of :func:`~lmi_suspension.mu.mussv` on a grid.
+  of :func:`~lmi_suspension.mu.mussv` on a grid and over every frequency, and the seat
+  the lower bound points to.
+
+:class:`MixedRsBound` is the set's robust stability for a *search*: the D-G bound with
+its scalings held fixed, a smooth function of the controller that
+:func:`~.refine.refine_seat_controller` takes as a requirement
+(``RefineOptions(occupants=...)``).
 
 Examples
 --------
@@ -44,12 +50,13 @@ from typing import Callable
 import control
 import numpy as np
 
-from ..errors import ParameterError
+from ..errors import DimensionError, ParameterError
 from .params import SeatParameters
 from .roads import RoadInput, bump
 
 __all__ = ["OccupantSet", "OccupantSamples", "OccupantCheck", "MixedMuCheck",
-           "occupant_samples", "certify_occupants", "occupant_mu"]
+           "MixedRsBound", "RsScalings", "occupant_samples", "certify_occupants",
+           "occupant_mu"]
 
 logger = logging.getLogger(__name__)
 
@@ -414,6 +421,15 @@ class MixedMuCheck:
         (:func:`~lmi_suspension.mu.interval_bound` with the grid's scalings): ``rs_sup
         < 1`` certifies robust stability between the grid points too.
     omega : ndarray
+    rs_worst : SeatParameters or None
+        The seat of the robust-stability lower bound's perturbation (its real scalars,
+        at the grid frequency of the largest lower bound): where ``rs_lower >= 1`` a
+        seat of the set at which a perturbation of the delay cover no larger than
+        ``1 / rs_lower`` destabilises the loop; below 1, that perturbation scaled onto
+        the set's boundary (the direction closest to instability).  None where the
+        lower bound is 0.
+    rs_worst_omega : float
+        Its frequency, rad/s.
     """
 
     block_names: tuple
@@ -426,6 +442,32 @@ class MixedMuCheck:
     omega: np.ndarray
     rs_sup: float
     rp_sup: float
+    rs_worst: SeatParameters | None = None
+    rs_worst_omega: float = math.nan
+
+
+def _lower_bound_seat(aug, rs) -> tuple[SeatParameters | None, float]:
+    """``(seat, ω)`` of the robust-stability lower bound's perturbation (see
+    :attr:`MixedMuCheck.rs_worst`)."""
+    from ..mu.blocks import BlockStructure
+    from .uncertainty import parametric_uncertainty
+
+    lower = np.asarray(rs.lower, dtype=float).ravel()
+    k = int(np.argmax(lower))
+    if not lower[k] > 0:
+        return None, math.nan
+    Delta = np.asarray(rs.delta)[..., k] if np.ndim(rs.delta) == 3 else np.asarray(rs.delta)
+    struct = BlockStructure.coerce(np.asarray(aug.blk)[:-1])
+    # a block of Δ sits at M's column rows and row columns (Δ is n_in × n_out)
+    delta = {name: float(np.real(Delta[rows, cols][0, 0])) for name, rows, cols
+             in zip(aug.block_names, struct.col_slices(), struct.row_slices())}
+    o = aug.options
+    pu = parametric_uncertainty(aug.params, o.m3_range, o.stiffness_rel, stiffness=o.stiffness,
+                                damping=o.damping, damping_rel=o.damping_rel)
+    scale = min(1.0, float(lower[k]))
+    d = [float(np.clip(delta[name] * scale, -1.0, 1.0)) for name in pu.names]
+    omega = rs.omega[k] if rs.omega is not None else math.nan
+    return pu.params_at(d), float(omega)
 
 
 def occupant_mu(K, occupants: OccupantSet | None = None, *, design=None, omega=None,
@@ -472,8 +514,200 @@ def occupant_mu(K, occupants: OccupantSet | None = None, *, design=None, omega=N
     rs_sup = interval_bound(CL[:CL.noutputs - rows, :CL.ninputs - cols], rs, omega)
     rp_sup = interval_bound(CL, rp, omega)
     rsu, rpu = np.asarray(rs.upper), np.asarray(rp.upper)
+    worst, worst_omega = _lower_bound_seat(aug, rs)
     return MixedMuCheck(block_names=names, rs_upper=float(rsu.max()),
                         rs_lower=float(np.max(rs.lower)), rp_upper=float(rpu.max()),
                         rp_lower=float(np.max(rp.lower)), rs_omega=float(omega[rsu.argmax()]),
                         rp_omega=float(omega[rpu.argmax()]), omega=omega,
-                        rs_sup=rs_sup.bound, rp_sup=rp_sup.bound)
+                        rs_sup=rs_sup.bound, rp_sup=rp_sup.bound, rs_worst=worst,
+                        rs_worst_omega=worst_omega)
+
+
+# ------------------------------------------------------- robust stability inside a search
+
+#: Frequencies a search's scalings are also held at besides its grid: the points where
+#: :func:`~lmi_suspension.mu.interval_bound` split an interval (the sharp peaks of real
+#: parameters, which a grid misses), the highest first.  The first multi-seat design's
+#: 200-point grid read 0.869 where the sup over every frequency was 1.048, at one such
+#: point (2026-11-27).
+_RS_EXTRA = 6
+
+
+@dataclass(frozen=True)
+class RsScalings:
+    """D-G scalings of the set's robust-stability µ held fixed at frequencies
+    (:meth:`MixedRsBound.scalings`).
+
+    Attributes
+    ----------
+    omega : ndarray
+        The frequencies, rad/s: the grid, then the split points of
+        :func:`~lmi_suspension.mu.interval_bound` (:data:`_RS_EXTRA` of them, the
+        highest bounds first; the grid's peak repeated where there are fewer).
+    XL, G : ndarray
+        ``(F, n, n)``: ``X_L = D_Lᴴ D_L`` and ``G`` at each frequency.
+    Linv : ndarray
+        ``(F, n, n)``: the inverse of the Cholesky factor of ``X_R``.
+    upper : ndarray
+        The µ upper bound those scalings were found for at each frequency.
+    sup : float
+        The bound over every frequency for the controller they were found for.
+    """
+
+    omega: np.ndarray
+    XL: np.ndarray
+    G: np.ndarray
+    Linv: np.ndarray
+    upper: np.ndarray
+    sup: float
+    _blocks: tuple = field(repr=False)
+
+
+class MixedRsBound:
+    """Robust stability over an :class:`OccupantSet` as a smooth function of the
+    controller, for searches.
+
+    The D-G upper bound of mixed µ holds for *any* admissible scalings ``(X_L, X_R, G)``:
+    ``β(ω) = min{β : M* X_L M + j(G M - M* Gᴴ) ⪯ β² X_R}`` bounds µ of ``M(jω)``.  With
+    the scalings held fixed, ``β`` is a smooth function of the controller (where the
+    largest generalized eigenvalue is simple), whereas the optimised bound is not (its
+    scalings jump).  :meth:`scalings` optimises them for one controller (SLICOT's
+    AB13MD through :func:`~lmi_suspension.mu.mussv`, certified) on the grid and at the
+    points where :func:`~lmi_suspension.mu.interval_bound` had to split;
+    :meth:`levels` evaluates ``β`` for another controller at those scalings, an upper
+    bound of its µ at those frequencies: the classical D-K alternation, with the K-step a
+    local search (:func:`~.refine.refine_seat_controller` with
+    ``RefineOptions(occupants=...)``).
+
+    Parameters
+    ----------
+    occupants : OccupantSet, optional
+    design : SeatDesignOptions, optional
+        The delay cover (:data:`~.design.DEFAULT_DESIGN` by default).
+    omega : array_like, optional
+        Grid, rad/s (200 points over 0.1–3162 rad/s by default).
+
+    Examples
+    --------
+    >>> from lmi_suspension.seat.refine import load_refined
+    >>> K = load_refined()[0]
+    >>> rs = MixedRsBound(omega=np.logspace(-1, 3.5, 40))
+    >>> scal = rs.scalings(K)
+    >>> bool(np.allclose(rs.levels(K, scal), scal.upper, rtol=1e-6))
+    True
+    """
+
+    def __init__(self, occupants: OccupantSet | None = None, design=None, omega=None):
+        from ..mu.blocks import BlockStructure
+        from .augmented import seat_augmented_plant
+
+        occupants = OccupantSet() if occupants is None else occupants
+        if not isinstance(occupants, OccupantSet):
+            raise ParameterError(f"occupants must be an OccupantSet, got "
+                                 f"{type(occupants).__name__}")
+        omega = np.logspace(-1.0, 3.5, 200) if omega is None else \
+            np.asarray(omega, dtype=float).ravel()
+        if omega.size < 2 or not np.all(np.isfinite(omega)) or np.any(omega <= 0) \
+                or np.any(np.diff(omega) <= 0):
+            raise ParameterError("omega must hold increasing positive finite frequencies")
+        aug = seat_augmented_plant(occupants.mu_design(design), occupants.nominal)
+        blk = np.asarray(aug.blk)
+        if tuple(aug.block_names)[-1] != "performance":
+            raise ParameterError("the design's structure must end with the performance block")
+        nz, nw = BlockStructure.coerce(blk).shape_M
+        self.occupants, self.omega, self.blk = occupants, omega, blk[:-1]
+        if aug.ncon != 1:
+            raise DimensionError(f"a seat controller has one output, the design {aug.ncon}")
+        self._P, self._ny, self._nu = aug.P, aug.nmeas, aug.ncon
+        self._nz, self._nw = nz, nw
+        # the robust-stability loop leaves out the performance block's rows and columns
+        self._nq, self._np = nz - int(blk[-1, 1]), nw - int(blk[-1, 0])
+
+    def _blocks(self, omega):
+        from ..lti import freqresp
+
+        Pw = freqresp(self._P, omega)
+        nz, nw, nq, n_p = self._nz, self._nw, self._nq, self._np
+        return (Pw[:nq, :n_p], Pw[:nq, nw:nw + self._nu][:, 0], Pw[nz:nz + self._ny, :n_p],
+                Pw[nz:nz + self._ny, nw:nw + self._nu][:, 0])
+
+    def loop(self, K) -> control.StateSpace:
+        """The robust-stability loop ``M(s)`` (the performance channels left out)."""
+        from ..lti import lft
+
+        CL = lft(self._P, control.ss(K.A, K.B, K.C, K.D), self._ny, self._nu)
+        return CL[:self._nq, :self._np]
+
+    def loop_poles(self, K) -> np.ndarray:
+        """Poles of the loop (the weights' and the delay cover's included)."""
+        P = self._P
+        A, B, C = (np.asarray(m, dtype=float) for m in (P.A, P.B, P.C))
+        B2, C2 = B[:, self._nw:self._nw + self._nu], C[self._nz:self._nz + self._ny]
+        Ak, Bk, Ck, Dk = (np.asarray(m, dtype=float) for m in (K.A, K.B, K.C, K.D))
+        return np.linalg.eigvals(np.block([[A + B2 @ Dk @ C2, B2 @ Ck], [Bk @ C2, Ak]]))
+
+    def scalings(self, K) -> RsScalings:
+        """Optimal scalings for ``K`` on the grid and at the points between grid points
+        where the bound over every frequency needed them.
+
+        Raises
+        ------
+        ParameterError
+            ``K``'s loop is unstable (no µ bound certifies it).
+        """
+        from ..lti import freqresp
+        from ..mu import MussvOptions, interval_bound, mussv
+        from ..mu.interval import _scalings
+
+        if np.max(self.loop_poles(K).real, initial=-np.inf) >= 0:
+            raise ParameterError("the controller's µ loop is unstable")
+        CL = self.loop(K)
+        only_upper = MussvOptions(compute_lower=False)
+        mu = mussv(freqresp(CL, self.omega), self.blk, omega=self.omega, options=only_upper)
+        sup = interval_bound(CL, mu, self.omega)
+        grid = set(self.omega.tolist())
+        # the split points, and the point that sets the bound where an interval got its
+        # own level (it lies inside the interval, not at an edge)
+        split = np.array(sorted({float(w) for w in np.append(sup.edges, sup.omega)
+                                 if 0 < w < np.inf and w not in grid}))
+        scal = [_scalings(mu, k) for k in range(self.omega.size)]
+        upper = list(np.asarray(mu.upper, dtype=float))
+        extra_w: list = []
+        if split.size:
+            at = mussv(freqresp(CL, split), self.blk, omega=split, options=only_upper)
+            order = np.argsort(-np.asarray(at.upper), kind="stable")[:_RS_EXTRA]
+            extra_w = [float(split[k]) for k in order]
+            scal += [_scalings(at, int(k)) for k in order]
+            upper += [float(np.asarray(at.upper)[k]) for k in order]
+        top = int(np.argmax(mu.upper))
+        while len(extra_w) < _RS_EXTRA:    # a fixed count: the search's constraints need it
+            extra_w.append(float(self.omega[top]))
+            scal.append(scal[top])
+            upper.append(upper[top])
+        omega = np.concatenate([self.omega, extra_w])
+        XL = np.array([s[0] for s in scal])
+        XR = np.array([(s[1] + s[1].conj().T) / 2 for s in scal])
+        try:
+            Linv = np.linalg.inv(np.linalg.cholesky(XR))
+        except np.linalg.LinAlgError as exc:
+            raise ParameterError(f"the µ scalings are not positive definite ({exc})") from exc
+        return RsScalings(omega=omega, XL=XL, G=np.array([s[2] for s in scal]), Linv=Linv,
+                          upper=np.array(upper), sup=float(sup.bound),
+                          _blocks=self._blocks(omega))
+
+    def levels(self, K, scal: RsScalings) -> np.ndarray:
+        """``β`` at each of ``scal``'s frequencies for ``K``: upper bounds of its µ there
+        (``K``'s loop must be stable; :meth:`loop_poles` tells)."""
+        from .refine import frequency_response
+
+        P11, P12, P21, P22 = scal._blocks
+        Kw = frequency_response(K, 1j * scal.omega)                 # (ny, F)
+        loop = 1.0 - np.einsum("yf,yf->f", Kw, P22)
+        KP21 = np.einsum("yf,ywf->wf", Kw, P21) / loop
+        M = np.moveaxis(P11 + P12[:, None, :] * KP21[None, :, :], -1, 0)    # (F, nq, np)
+        MH = np.conj(np.swapaxes(M, 1, 2))
+        GM = scal.G @ M
+        H = MH @ scal.XL @ M + 1j * (GM - np.conj(np.swapaxes(GM, 1, 2)))
+        S = scal.Linv @ H @ np.conj(np.swapaxes(scal.Linv, 1, 2))
+        S = (S + np.conj(np.swapaxes(S, 1, 2))) / 2
+        return np.sqrt(np.maximum(np.linalg.eigvalsh(S)[:, -1], 0.0))

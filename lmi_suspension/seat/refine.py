@@ -438,6 +438,18 @@ _MU_GRID = np.logspace(-3.0, 4.0, 200)
 #: iterations per stage reached a bump peak of 8.83 m/s² after 600 iterations, 60 reached
 #: 8.73 (8.725 after 960), 2026-11-26, with the search's first 150-point µ grid.
 _STAGE_ITER = 60
+#: The stage length with the set's scalings (``RefineOptions.occupants``): they are held
+#: fixed through a stage and grow conservative as the controller moves away from the
+#: start they were optimised for (one stage of 30 iterations took the bound they give to
+#: 1.029 where fresh ones gave 0.906), but a stage of 10 found no better point three
+#: times in a row from the first multi-seat design (2026-11-27).
+_RS_STAGE_ITER = 30
+#: The first trust box with the set's scalings.  From the first multi-seat design
+#: (µ of the set 1.048, two seats, 30 iterations, 2026-11-27): with the box of 0.5 the
+#: first stage's best point lowered the set's bound to 0.906 at the price of a peak of
+#: 5.77 × its own limit (from 2.54), and the next stage found nothing better; with 0.1,
+#: 0.901 and 2.51.  Close to a start whose scalings are fresh, they stay tight.
+_RS_TRUST_START = 0.1
 _TRUST_START = 0.5
 _TRUST_MIN = 1e-3
 #: every loop pole's real part must stay below minus this (rad/s), so that the FFT
@@ -537,6 +549,14 @@ class RefineOptions:
         performance block (robust performance of the µ weights, True), or the delay
         cover's gain alone, as at the plants (robust stability, False: the road
         requirements are then the only performance asked for).
+    occupants : OccupantSet, optional
+        Robust stability over this whole set too: mixed µ (its parameters real, the
+        delay cover complex) below ``mu_max`` on a 200-point grid and at the points
+        between where the bound over every frequency peaks, each by the D-G bound with
+        scalings held fixed through a stage and optimised anew for the stage's start
+        (:class:`~.occupants.MixedRsBound`; about 7 s per stage, 3 ms per evaluation).
+        A met requirement is then a certificate at those frequencies;
+        :func:`~.occupants.occupant_mu` certifies every frequency.
     """
 
     u_bound: float = 1500.0
@@ -547,6 +567,7 @@ class RefineOptions:
     max_iter: int = 600
     plants: tuple = ()
     mu_performance: bool = True
+    occupants: object = None
 
     def __post_init__(self):
         for name in ("u_bound", "z_bound", "mu_max", "disk_radius"):
@@ -565,6 +586,12 @@ class RefineOptions:
         object.__setattr__(self, "plants", plants)
         if not isinstance(self.mu_performance, bool):
             raise ParameterError("mu_performance must be True or False")
+        if self.occupants is not None:
+            from .occupants import OccupantSet
+
+            if not isinstance(self.occupants, OccupantSet):
+                raise ParameterError(f"occupants must be an OccupantSet, got "
+                                     f"{type(self.occupants).__name__}")
 
 
 @dataclass(frozen=True)
@@ -611,7 +638,7 @@ class _Problem:
     """The parametrisation (real modal form, normalised) and the exact evaluations."""
 
     def __init__(self, K0: control.StateSpace, opts: RefineOptions, seats: list,
-                 mu: TwoBlockMu):
+                 mu: TwoBlockMu, rs=None):
         A = np.asarray(K0.A)
         self.n = A.shape[0]
         self.kinds, poles, i = [], [], 0
@@ -637,6 +664,8 @@ class _Problem:
         floor = np.maximum(floor, 1e-12)
         self.scale = np.concatenate([np.ones(self.npole), np.maximum(np.abs(gains), floor)])
         self.opts, self.seats, self.mu = opts, seats, mu
+        # the set's robust stability (MixedRsBound) and the stage's scalings
+        self.rs, self.rs_scal = rs, None
         tight = 1.0 - 2 * _MARGIN
         self.bounds = dict(u=opts.u_bound * tight, x1=opts.z_bound * tight,
                            mu=opts.mu_max * tight, radius=opts.disk_radius * tight)
@@ -663,6 +692,14 @@ class _Problem:
         D = x[j + n * ny + n:].reshape(1, ny)
         return control.ss(A, B, C, D)
 
+    def rescale(self, y: np.ndarray) -> _Point | None:
+        """Optimise the set's scalings for the controller at ``y`` and forget every
+        evaluation made with the previous ones (their µ figures were other bounds)."""
+        self.rs_scal = self.rs.scalings(self.controller(y))
+        self._cache.clear()
+        self.best = self.best_y = None
+        return self.evaluate(y)
+
     def evaluate(self, y: np.ndarray) -> _Point | None:
         key = y.tobytes()
         if key not in self._cache:
@@ -684,6 +721,10 @@ class _Problem:
                           if s.cover is not None]
                 poles = np.concatenate([loop_poles(K, s.params) for s in self.seats] + [pa]
                                        + [pc for _, pc in covers])
+                # the set's µ loop: its stability only (its weights' poles are not the
+                # loop's shape)
+                if self.rs is not None and np.max(self.rs.loop_poles(K).real) >= 0:
+                    return None
             except np.linalg.LinAlgError:
                 return None
             if not np.all(np.isfinite(poles)) or np.max(poles.real) >= 0:
@@ -697,6 +738,8 @@ class _Problem:
                 rp = [curve, top, self.mu.curve(K, _resonance_points(pa))]
             else:
                 rp = _cover_points(self.mu, K, pa)
+            if self.rs is not None:
+                rp.append(self.rs.levels(K, self.rs_scal))
             mu = np.concatenate(rp + [g for cover, pc in covers
                                       for g in _cover_points(cover, K, pc)])
         b = self.bounds
@@ -731,7 +774,10 @@ def _slsqp(z0, grad, bounds, constraints, maxiter: int):
 
 @dataclass(frozen=True)
 class RefineStage:
-    """One trust-region stage of :func:`refine_seat_controller` (progress record)."""
+    """One trust-region stage of :func:`refine_seat_controller` (progress record).
+
+    ``rs_sup`` is the set's robust-stability µ over every frequency at the stage's start
+    with ``RefineOptions.occupants`` (nan without)."""
 
     index: int
     iterations: int
@@ -744,6 +790,7 @@ class RefineStage:
     radius: float
     violation: float
     seconds: float
+    rs_sup: float = float("nan")
 
 
 @dataclass(frozen=True)
@@ -764,7 +811,8 @@ class RefinedDesign:
     mu : float
         µ peak on the search grid, its refined maxima and the resonances (with
         ``options.plants`` or ``mu_performance=False``: or the largest delay-cover gain,
-        evaluated at the same kinds of points, if larger).
+        evaluated at the same kinds of points, if larger; with ``options.occupants``:
+        or the set's mixed-µ bound at the last stage's scalings, if larger).
     radius : float
         Largest controller or loop pole magnitude, rad/s.
     met : bool
@@ -774,6 +822,10 @@ class RefinedDesign:
     iterations : int
         SLSQP iterations in all.
     seconds : float
+    rs_sup : float
+        With ``options.occupants``: the set's robust-stability µ of ``K`` over every
+        frequency, with scalings optimised for ``K`` itself (``met`` judged the search's
+        scalings, found for the last stage's start); nan without.
     """
 
     K: control.StateSpace
@@ -788,6 +840,7 @@ class RefinedDesign:
     stages: tuple
     iterations: int
     seconds: float
+    rs_sup: float = float("nan")
 
 
 def _seats(opts: RefineOptions, design: SeatDesignOptions, params, road) -> list:
@@ -861,20 +914,39 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
             raise ParameterError("K0 has non-finite entries")
     start = modal_form(K0, radius=opts.disk_radius)
     design = DEFAULT_DESIGN if design is None else design
+    rs = None
+    if opts.occupants is not None:
+        from .occupants import MixedRsBound
+
+        rs = MixedRsBound(opts.occupants, design)
     prob = _Problem(start, opts, _seats(opts, design, params, road),
-                    TwoBlockMu(design, _MU_GRID, params))
+                    TwoBlockMu(design, _MU_GRID, params), rs)
     y = prob.x0 / prob.scale
-    best = prob.evaluate(y)
+    unstable = ParameterError("K0's loop (residualised to the disk) is not stable")
+    if rs is not None:
+        if np.max(rs.loop_poles(prob.controller(y)).real) >= 0:
+            raise unstable
+        best = prob.rescale(y)
+    else:
+        best = prob.evaluate(y)
     if best is None:
-        raise ParameterError("K0's loop (residualised to the disk) is not stable")
+        raise unstable
     prob.size = prob.constraints(np.concatenate([[best.objective], y])).size
     lower = np.full(y.size, -np.inf)
     upper = np.full(y.size, np.inf)
     lower[:prob.npole] = np.log(1e-3)
     upper[:prob.npole] = np.log(opts.disk_radius)
-    trust, iterations, stages = _TRUST_START, 0, []
+    trust, iterations, stages = (_TRUST_START if rs is None else _RS_TRUST_START), 0, []
+    stage_iter = _STAGE_ITER if rs is None else _RS_STAGE_ITER
     while iterations < opts.max_iter and trust >= _TRUST_MIN:
         t0 = time.perf_counter()
+        if rs is not None and stages and stages[-1].accepted:
+            # the D-step of the alternation: scalings for the stage's start (after a
+            # rejected stage the start, and so its scalings, are the same).  The start's
+            # figures may rise with them: new split points can hold a peak the last missed
+            best = prob.rescale(y)
+            logger.info("refine stage %d: the set's robust-stability µ %.4f over every "
+                        "frequency at its start", len(stages) + 1, prob.rs_scal.sup)
         # the epigraph variable t first: minimise t with every peak below it
         z0 = np.concatenate([[best.objective], y])
         lo = np.concatenate([[0.0], np.maximum(lower, y - trust)])
@@ -882,7 +954,7 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
         grad = np.zeros(z0.size)
         grad[0] = 1.0
         res = _slsqp(z0, grad, list(zip(lo, hi)), prob.constraints,
-                     min(_STAGE_ITER, opts.max_iter - iterations))
+                     min(stage_iter, opts.max_iter - iterations))
         iterations += int(res.nit)
         prob.evaluate(np.clip(res.x[1:], np.maximum(lower, y - trust),
                               np.minimum(upper, y + trust)))
@@ -895,7 +967,8 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
                           accepted=accepted, peak=best.objective,
                           u_peak=float(np.max(best.u)), x1_peak=float(np.max(best.x1)),
                           mu=best.mu, radius=best.radius, violation=best.violation,
-                          seconds=time.perf_counter() - t0)
+                          seconds=time.perf_counter() - t0,
+                          rs_sup=float("nan") if rs is None else prob.rs_scal.sup)
         stages.append(rec)
         logger.info("refine stage %d: %s, peak %.3f m/s², |u| %.0f N, µ %.4f, radius %.0f, "
                     "violation %.2g (%d iterations, %.1f s)", rec.index,
@@ -903,16 +976,17 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
                     rec.radius, rec.violation, rec.iterations, rec.seconds)
         if callback is not None:
             callback(rec)
-        if accepted and best.violation <= _MARGIN and res.success and res.nit < _STAGE_ITER:
+        if accepted and best.violation <= _MARGIN and res.success and res.nit < stage_iter:
             break        # SLSQP converged inside the box: a local optimum
     K = prob.controller(y)
     K = control.ss(K.A, K.B, K.C, K.D, inputs=["x1", "x3"], outputs=["u"], name="K_refined")
+    rs_sup = float("nan") if rs is None else rs.scalings(K).sup
     per_delay = (lambda v: np.max(v.reshape(len(prob.seats), -1), axis=0))
     return RefinedDesign(K=K, K0=start, peak=per_delay(best.z), u_peak=per_delay(best.u),
                          x1_peak=per_delay(best.x1),
                          mu=best.mu, radius=best.radius, met=best.violation <= _MARGIN,
                          options=opts, stages=tuple(stages), iterations=iterations,
-                         seconds=time.perf_counter() - t_start)
+                         seconds=time.perf_counter() - t_start, rs_sup=rs_sup)
 
 
 # ----------------------------------------------------------------------------- certificate
@@ -1031,6 +1105,10 @@ def save_refined(path, d: RefinedDesign, *, dt: float = 1e-3) -> Path:
         meta["plants"] = [asdict(p) for p in o.plants]
     if not o.mu_performance:
         meta["mu_performance"] = False
+    if o.occupants is not None:
+        meta["rs_sup"] = d.rs_sup
+        meta["occupants"] = {name: [lo, hi] for name, lo, hi in o.occupants.ranges()}
+        meta["occupants_delay"] = list(o.occupants.delay)
     return save_controller(path, d.K, inputs=["x1", "x3"], outputs=["u"], metadata=meta,
                            discrete=discretise_controller(d.K, dt))
 
