@@ -7,6 +7,8 @@ implementation) and from independent computations inside the tests.
 """
 
 
+import time
+
 import control
 import numpy as np
 import pytest
@@ -292,6 +294,41 @@ def test_ab13md_failure_falls_back_to_the_lmi(monkeypatch, caplog, failure):
     assert res.upper == pytest.approx(lmi.upper, rel=1e-9)
     assert lmi_certified_bound(M, res) <= res.upper * (1 + 1e-9)
     assert "LMI bound was used there" in caplog.text
+
+
+@pytest.mark.parametrize("slow", ["cold call", "every call"])
+def test_ab13md_that_does_not_return_is_stopped(monkeypatch, caplog, slow):
+    """AB13MD's loops have no iteration bound (one cold call on the seat took 63 s, a
+    warm-started one did not return in 300 s).  Injected: AB13MD that sleeps 60 s on a
+    cold call (or on every call).  mussv stops it at its limit (here 0.5 s), starts it
+    again from the Perron scaling, and past that takes the LMI; either way the bound is
+    certified and the call returns in seconds."""
+    slycot = pytest.importorskip("slycot")
+    import lmi_suspension.mu.bounds as bounds
+
+    real = slycot.ab13md
+
+    def sleepy(Z, nblock, itype, *x):
+        if slow == "every call" or not x:
+            time.sleep(60.0)
+        return real(Z, nblock, itype, *x)
+
+    monkeypatch.setattr(slycot, "ab13md", sleepy)
+    monkeypatch.setattr(bounds, "_AB13MD_SECONDS", 0.5)
+    M = AB13MD_Z
+    t0 = time.perf_counter()
+    with caplog.at_level("INFO", logger="lmi_suspension.mu.bounds"):
+        res = mussv(M, AB13MD_BLK, method="ab13md")
+    assert time.perf_counter() - t0 < 20.0
+    assert "did not return within 0.5 s" in caplog.text
+    assert lmi_certified_bound(M, res) <= res.upper * (1 + 1e-9)
+    if slow == "cold call":
+        # the warm start reaches SLICOT's documented value as well
+        assert res.upper == pytest.approx(AB13MD_BOUND, rel=1e-6)
+        assert "LMI bound was used" not in caplog.text
+    else:
+        assert res.upper == pytest.approx(mussv(M, AB13MD_BLK, method="lmi").upper, rel=1e-9)
+        assert "LMI bound was used there" in caplog.text
 
 
 # ------------------------------------------------------------------ real blocks

@@ -52,6 +52,7 @@ import scipy.sparse as sp
 from ..errors import DimensionError, InputError
 from ..lti.checks import as_finite_array
 from .blocks import BlockKind, BlockStructure
+from .timelimit import TimeLimited
 
 __all__ = ["MussvOptions", "MussvResult", "MussvTimings", "mussv"]
 
@@ -61,6 +62,10 @@ _METHODS = ("auto", "fast", "lmi", "ab13md")
 #: AB13MD's value is taken where the numpy check of its scalings confirms it to this
 #: relative margin (they agreed to 1e-9 on the seat's occupant structure)
 _AB13MD_CONFIRM = 1e-6
+#: wall-clock limit of one AB13MD call, in seconds.  Cold calls on the seat's set loops
+#: took 6–130 ms, with two outliers on the µ controller's loop: 4.1 s and 63 s
+#: (2026-11-27, :mod:`.timelimit`); the limit leaves the 4 s call a 5× slower machine.
+_AB13MD_SECONDS = 20.0
 
 
 @dataclass(frozen=True)
@@ -537,21 +542,40 @@ def _ab13md_blocks(struct: BlockStructure):
     return np.array(nblock, dtype=int), np.array(itype, dtype=int)
 
 
-def _ab13md_upper(M, blocks):
+def _ab13md_call(Z, nblock, itype, x):
+    """slycot's AB13MD, cold (``x`` None) or warm-started; ``(bound, d, g)``."""
+    from slycot import ab13md
+
+    bound, d, g, _ = ab13md(Z, nblock, itype) if x is None else ab13md(Z, nblock, itype, x)
+    return bound, d, g
+
+
+def _ab13md_upper(M, blocks, call, logd0):
     """AB13MD's D-G bound of ``M`` with its scalings ``(X, X, G)``, the bound being the
     one those scalings certify (:func:`_certify`); ``(inf, None)`` where AB13MD fails or
     the certificate does not confirm its value.
+
+    ``call`` runs AB13MD under a time limit (:class:`~.timelimit.TimeLimited`).  A cold
+    call past the limit is retried once from the Perron scaling ``exp(logd0)`` (one log
+    scaling per block): on the 63 s matrix of :mod:`.timelimit` that warm start took
+    3.5 s and certified 0.693133 against the cold 0.693665, where the LMI route stalls
+    at 1.190.
 
     The certificate holds for the structure only if ``D`` is one scalar on each full
     block and ``G`` is zero outside the real scalars: ``G`` is zeroed there and a ``D``
     that varies inside a block is refused, so that the bound never rests on AB13MD's
     word for the structure."""
-    from slycot import ab13md
-
     nblock, itype = blocks
+    Mc = np.asarray(M, dtype=complex)
+    # AB13MD's warm start: squared scalings relative to the first block, then G (zero)
+    x0 = np.concatenate([np.exp(2.0 * (logd0[1:] - logd0[0])), np.zeros(np.sum(itype == 1))])
     try:
-        bound, d, g, _ = ab13md(np.asarray(M, dtype=complex), nblock, itype)
-    except Exception as exc:        # slycot's arithmetic errors and bad workspace alike
+        try:
+            bound, d, g = call(Mc, nblock, itype, None)
+        except TimeoutError as exc:
+            logger.info("%s; AB13MD is started again from the Perron scaling", exc)
+            bound, d, g = call(Mc, nblock, itype, x0)
+    except Exception as exc:        # slycot's arithmetic errors, bad workspace, time limit
         logger.info("AB13MD failed (%s); the LMI bound is used", exc)
         return np.inf, None
     d, g = np.asarray(d, dtype=float), np.asarray(g, dtype=float)
@@ -984,89 +1008,97 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
     full_idx = [i for i, b in enumerate(struct.blocks) if b.kind is BlockKind.FULL]
     ref = full_idx[-1] if full_idx else m - 1
 
-    for k in range(nf):
-        Mk = stack[:, :, k]
-        nrm = np.linalg.norm(Mk, 2)
-        if nrm == 0:
-            DL[:, :, k], DR[:, :, k] = np.eye(nout), np.eye(nin)
-            continue
-        # ---------------- fast upper bound (also the LMI's starting point)
-        t0 = time.perf_counter()
-        perron = _perron_logd(Mk, struct, rl, cl) if (x_prev is None or use != "fast") else None
-        ub_fast, logd = None, None
-        if fast_ok and (use == "fast" or opts.lmi_warm_start):
-            # Warm start from the previous frequency; Perron only to begin a sweep.
-            x0s = [perron] if x_prev is None else [x_prev]
-            ub_fast, logd, H_prev = _fast_upper(Mk, struct, rl, cl, x0s, opts, H_prev)
-            x_prev = logd
-        t_up += time.perf_counter() - t0
+    # AB13MD runs under a time limit (its loops have no bound); the child process
+    # it runs in lives for this call only
+    ab_call = TimeLimited(_ab13md_call, _AB13MD_SECONDS) if use == "ab13md" else None
+    try:
+        for k in range(nf):
+            Mk = stack[:, :, k]
+            nrm = np.linalg.norm(Mk, 2)
+            if nrm == 0:
+                DL[:, :, k], DR[:, :, k] = np.eye(nout), np.eye(nin)
+                continue
+            # ---------------- fast upper bound (also the LMI's starting point)
+            t0 = time.perf_counter()
+            perron = _perron_logd(Mk, struct, rl, cl) if (x_prev is None or use != "fast") else None
+            ub_fast, logd = None, None
+            if fast_ok and (use == "fast" or opts.lmi_warm_start):
+                # Warm start from the previous frequency; Perron only to begin a sweep.
+                x0s = [perron] if x_prev is None else [x_prev]
+                ub_fast, logd, H_prev = _fast_upper(Mk, struct, rl, cl, x0s, opts, H_prev)
+                x_prev = logd
+            t_up += time.perf_counter() - t0
 
-        # ---------------- lower bound (it also brackets the LMI iteration)
-        t0 = time.perf_counter()
-        target = ub_fast if ub_fast is not None else np.inf
-        if batch:
-            lo_val, lo_delta, vecs = 0.0, None, None
-        elif opts.compute_lower:
-            lo_val, lo_delta, vecs = _power_lower(Mk, struct, rng, starts_prev, opts, target)
-        else:
-            lo_val, lo_delta, vecs = 0.0, None, None
-        if lone_real and opts.compute_lower:
-            v2, d2 = _single_real_block_lower(Mk, opts)
-            if v2 > lo_val:
-                lo_val, lo_delta = v2, d2
-        if vecs is not None:
-            starts_prev = [vecs]
-        t_lo += time.perf_counter() - t0
+            # ---------------- lower bound (it also brackets the LMI iteration)
+            t0 = time.perf_counter()
+            target = ub_fast if ub_fast is not None else np.inf
+            if batch:
+                lo_val, lo_delta, vecs = 0.0, None, None
+            elif opts.compute_lower:
+                lo_val, lo_delta, vecs = _power_lower(Mk, struct, rng, starts_prev, opts, target)
+            else:
+                lo_val, lo_delta, vecs = 0.0, None, None
+            if lone_real and opts.compute_lower:
+                v2, d2 = _single_real_block_lower(Mk, opts)
+                if v2 > lo_val:
+                    lo_val, lo_delta = v2, d2
+            if vecs is not None:
+                starts_prev = [vecs]
+            t_lo += time.perf_counter() - t0
 
-        # ---------------- upper bound
-        t0 = time.perf_counter()
-        if use == "fast":
-            ub = ub_fast
-            d = np.exp(logd)
-            dl, dr = struct.d_scalings(list(d))
-            XL, XR, Gk = dl @ dl, dr @ dr, np.zeros((nin, nout))
-        else:
-            ub, scal = (np.inf, None) if ab_blocks is None else _ab13md_upper(Mk, ab_blocks)
-            fallbacks += ab_blocks is not None and scal is None
-        if use != "fast" and scal is None:
-            if lmi is None:
-                lmi = _LmiBound(struct, opts)
-            d0 = np.exp(perron)
-            dl0, dr0 = struct.d_scalings(list(d0))
-            cand = [(nrm, (np.eye(nout), np.eye(nin), np.zeros((nin, nout)))),
-                    (_certify(Mk, dl0 @ dl0, dr0 @ dr0, np.zeros((nin, nout))),
-                     (dl0 @ dl0, dr0 @ dr0, np.zeros((nin, nout))))]
-            if ub_fast is not None:
-                dlf, drf = struct.d_scalings(list(np.exp(logd)))
-                # G=None marks scalings without a G part (filled with zeros below).
-                cand.append((ub_fast, (dlf @ dlf, drf @ drf, None)))
-            hi, scal_hi = min(cand, key=lambda c: c[0])
-            ub, scal, _ = _lmi_upper(Mk, lmi, hi, scal_hi, lo_val, opts)
-        if use != "fast":
-            XL, XR, Gk = scal
-            if Gk is None:
-                Gk = np.zeros((nin, nout))
-        t_up += time.perf_counter() - t0
+            # ---------------- upper bound
+            t0 = time.perf_counter()
+            if use == "fast":
+                ub = ub_fast
+                d = np.exp(logd)
+                dl, dr = struct.d_scalings(list(d))
+                XL, XR, Gk = dl @ dl, dr @ dr, np.zeros((nin, nout))
+            else:
+                ub, scal = (np.inf, None) if ab_blocks is None else _ab13md_upper(
+                    Mk, ab_blocks, ab_call, perron)
+                fallbacks += ab_blocks is not None and scal is None
+            if use != "fast" and scal is None:
+                if lmi is None:
+                    lmi = _LmiBound(struct, opts)
+                d0 = np.exp(perron)
+                dl0, dr0 = struct.d_scalings(list(d0))
+                cand = [(nrm, (np.eye(nout), np.eye(nin), np.zeros((nin, nout)))),
+                        (_certify(Mk, dl0 @ dl0, dr0 @ dr0, np.zeros((nin, nout))),
+                         (dl0 @ dl0, dr0 @ dr0, np.zeros((nin, nout))))]
+                if ub_fast is not None:
+                    dlf, drf = struct.d_scalings(list(np.exp(logd)))
+                    # G=None marks scalings without a G part (filled with zeros below).
+                    cand.append((ub_fast, (dlf @ dlf, drf @ drf, None)))
+                hi, scal_hi = min(cand, key=lambda c: c[0])
+                ub, scal, _ = _lmi_upper(Mk, lmi, hi, scal_hi, lo_val, opts)
+            if use != "fast":
+                XL, XR, Gk = scal
+                if Gk is None:
+                    Gk = np.zeros((nin, nout))
+            t_up += time.perf_counter() - t0
 
-        # ---------------- store, normalised on the reference block
-        cs_ref = struct.col_slices()[ref]
-        norm = np.real(np.trace(XR[cs_ref, cs_ref])) / struct.blocks[ref].rows
-        norm = norm if norm > 0 else 1.0
-        XL, XR, Gk = XL / norm, XR / norm, Gk / norm
-        DL[:, :, k], DR[:, :, k], G[:, :, k] = _sqrtm_psd(XL), _sqrtm_psd(XR), Gk
-        for i, (b, cs) in enumerate(zip(struct.blocks, struct.col_slices())):
-            dblk[i, k] = np.sqrt(max(np.real(np.trace(XR[cs, cs])) / b.rows, 0.0))
-        if lo_val > ub:
-            # Equal bounds can cross by round-off; anything larger is a numerical problem.
-            if lo_val > ub * (1 + 1e-8):
-                warnings.warn(
-                    f"mussv: lower bound {lo_val:.10g} exceeds upper bound {ub:.10g} at index {k}; clipped",
-                    RuntimeWarning, stacklevel=2,
-                )
-            lo_val = ub
-        upper[k], lower[k] = ub, lo_val
-        if lo_delta is not None:
-            delta[:, :, k] = lo_delta
+            # ---------------- store, normalised on the reference block
+            cs_ref = struct.col_slices()[ref]
+            norm = np.real(np.trace(XR[cs_ref, cs_ref])) / struct.blocks[ref].rows
+            norm = norm if norm > 0 else 1.0
+            XL, XR, Gk = XL / norm, XR / norm, Gk / norm
+            DL[:, :, k], DR[:, :, k], G[:, :, k] = _sqrtm_psd(XL), _sqrtm_psd(XR), Gk
+            for i, (b, cs) in enumerate(zip(struct.blocks, struct.col_slices())):
+                dblk[i, k] = np.sqrt(max(np.real(np.trace(XR[cs, cs])) / b.rows, 0.0))
+            if lo_val > ub:
+                # Equal bounds can cross by round-off; anything larger is a numerical problem.
+                if lo_val > ub * (1 + 1e-8):
+                    warnings.warn(
+                        f"mussv: lower bound {lo_val:.10g} exceeds upper bound {ub:.10g} at index {k}; clipped",
+                        RuntimeWarning, stacklevel=2,
+                    )
+                lo_val = ub
+            upper[k], lower[k] = ub, lo_val
+            if lo_delta is not None:
+                delta[:, :, k] = lo_delta
+    finally:
+        if ab_call is not None:
+            ab_call.close()
 
     if batch:
         t0 = time.perf_counter()

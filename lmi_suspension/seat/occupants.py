@@ -640,11 +640,9 @@ class MixedRsBound:
 
     def loop_poles(self, K) -> np.ndarray:
         """Poles of the loop (the weights' and the delay cover's included)."""
-        P = self._P
-        A, B, C = (np.asarray(m, dtype=float) for m in (P.A, P.B, P.C))
-        B2, C2 = B[:, self._nw:self._nw + self._nu], C[self._nz:self._nz + self._ny]
-        Ak, Bk, Ck, Dk = (np.asarray(m, dtype=float) for m in (K.A, K.B, K.C, K.D))
-        return np.linalg.eigvals(np.block([[A + B2 @ Dk @ C2, B2 @ Ck], [Bk @ C2, Ak]]))
+        from .refine import interconnection_poles
+
+        return interconnection_poles(self._P, K, self._nw, self._nu, self._nz, self._ny)
 
     def scalings(self, K) -> RsScalings:
         """Optimal scalings for ``K`` on the grid and at the points between grid points
@@ -698,13 +696,9 @@ class MixedRsBound:
     def levels(self, K, scal: RsScalings) -> np.ndarray:
         """``β`` at each of ``scal``'s frequencies for ``K``: upper bounds of its µ there
         (``K``'s loop must be stable; :meth:`loop_poles` tells)."""
-        from .refine import frequency_response
+        from .refine import loop_response
 
-        P11, P12, P21, P22 = scal._blocks
-        Kw = frequency_response(K, 1j * scal.omega)                 # (ny, F)
-        loop = 1.0 - np.einsum("yf,yf->f", Kw, P22)
-        KP21 = np.einsum("yf,ywf->wf", Kw, P21) / loop
-        M = np.moveaxis(P11 + P12[:, None, :] * KP21[None, :, :], -1, 0)    # (F, nq, np)
+        M = loop_response(K, scal.omega, scal._blocks)                  # (F, nq, np)
         MH = np.conj(np.swapaxes(M, 1, 2))
         GM = scal.G @ M
         H = MH @ scal.XL @ M + 1j * (GM - np.conj(np.swapaxes(GM, 1, 2)))

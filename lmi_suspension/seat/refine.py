@@ -158,6 +158,29 @@ def frequency_response(K, s: np.ndarray) -> np.ndarray:
     return np.einsum("ny,nf->yf", r, 1.0 / (s[None, :] - lam[:, None])) + D.T
 
 
+def loop_response(K, omega: np.ndarray, blocks) -> np.ndarray:
+    """``F_l(P, K)(jω)`` of a plant with one control input, shape ``(F, nz, nw)``, from
+    the plant's responses ``blocks = (P11, P12, P21, P22)`` on ``omega`` (``P12`` and
+    ``P22`` with their one input column dropped)."""
+    P11, P12, P21, P22 = blocks
+    Kw = frequency_response(K, 1j * omega)                  # (ny, F)
+    loop = 1.0 - np.einsum("yf,yf->f", Kw, P22)
+    KP21 = np.einsum("yf,ywf->wf", Kw, P21) / loop
+    return np.moveaxis(P11 + P12[:, None, :] * KP21[None, :, :], -1, 0)
+
+
+def interconnection_poles(P, K, nw: int, nu: int, nz: int, ny: int) -> np.ndarray:
+    """Poles of ``F_l(P, K)`` where ``P`` has ``nw + nu`` inputs and ``nz + ny``
+    outputs and ``D22 = 0``, as every seat plant here has (a nonzero ``D22`` is a
+    :class:`DimensionError`: the formula below would be wrong for it)."""
+    A, B, C = (np.asarray(m, dtype=float) for m in (P.A, P.B, P.C))
+    if np.any(np.asarray(P.D, dtype=float)[nz:nz + ny, nw:nw + nu] != 0):
+        raise DimensionError("interconnection_poles needs D22 = 0")
+    B2, C2 = B[:, nw:nw + nu], C[nz:nz + ny]
+    Ak, Bk, Ck, Dk = (np.asarray(m, dtype=float) for m in (K.A, K.B, K.C, K.D))
+    return np.linalg.eigvals(np.block([[A + B2 @ Dk @ C2, B2 @ Ck], [Bk @ C2, Ak]]))
+
+
 def loop_poles(K, params: SeatParameters | None = None) -> np.ndarray:
     """Poles of the seat with ``u = K y`` and no delay."""
     M = seat_matrices(params)
@@ -219,11 +242,7 @@ class TwoBlockMu:
     def loop_poles(self, K) -> np.ndarray:
         """Poles of the µ loop ``F_l(P, K)`` (the weights' poles included)."""
         c = self._c
-        P = c["P"]
-        A, B, C = (np.asarray(m, dtype=float) for m in (P.A, P.B, P.C))
-        B2, C2 = B[:, c["nw"]:c["nw"] + c["nu"]], C[c["nz"]:c["nz"] + c["ny"]]
-        Ak, Bk, Ck, Dk = (np.asarray(m, dtype=float) for m in (K.A, K.B, K.C, K.D))
-        return np.linalg.eigvals(np.block([[A + B2 @ Dk @ C2, B2 @ Ck], [Bk @ C2, Ak]]))
+        return interconnection_poles(c["P"], K, c["nw"], c["nu"], c["nz"], c["ny"])
 
     def _loop(self, K, omega=None) -> np.ndarray:
         """The closed loop's response, shape ``(F, nz, nw)``, on the grid or at ``omega``."""
@@ -235,10 +254,7 @@ class TwoBlockMu:
         else:
             omega = np.asarray(omega, dtype=float).ravel()
             P11, P12, P21, P22 = self._blocks(freqresp(c["P"], omega))
-        Kw = frequency_response(K, 1j * omega)                  # (ny, F)
-        loop = 1.0 - np.einsum("yf,yf->f", Kw, P22)
-        KP21 = np.einsum("yf,ywf->wf", Kw, P21) / loop
-        return np.moveaxis(P11 + P12[:, None, :] * KP21[None, :, :], -1, 0)
+        return loop_response(K, omega, (P11, P12, P21, P22))
 
     def cover_gain(self, K, omega=None) -> np.ndarray:
         """σ̄ of the first block's channel on the grid, or at ``omega`` (rad/s): µ of
@@ -924,6 +940,7 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
     y = prob.x0 / prob.scale
     unstable = ParameterError("K0's loop (residualised to the disk) is not stable")
     if rs is not None:
+        # checked here, not left to MixedRsBound.scalings, to name K0 in the error
         if np.max(rs.loop_poles(prob.controller(y)).real) >= 0:
             raise unstable
         best = prob.rescale(y)

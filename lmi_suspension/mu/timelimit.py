@@ -1,0 +1,140 @@
+"""A foreign routine run under a wall-clock limit, in a forked child process.
+
+Why a process: SLICOT's AB13MD (the mixed-µ upper bound :func:`~lmi_suspension.mu.mussv`
+takes by default) has loops without an iteration bound, its Osborne balancing and its
+barrier iteration.  On the seat's µ controller, one call at 1.6e-3 rad/s took 63 s
+(the other 103 calls of the same grid took 6–130 ms), and the same matrix with a warm
+start from the neighbouring frequency did not return in 300 s (2026-11-27).  A Fortran
+loop cannot be interrupted from Python, so the call runs in a child process that is
+killed when the limit passes, and the caller falls back to a route that has a bound.
+
+The child is forked once, on the first call, and serves every later call through a
+pipe until :meth:`TimeLimited.close`; forking this package's process takes about 22 ms
+(183 MB resident, this machine), a cold AB13MD call on the seat 6–20 ms.  Where
+``os.fork`` does not exist (Windows), the routine runs in-process, without a limit.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+from multiprocessing import Pipe
+
+__all__ = ["TimeLimited"]
+
+logger = logging.getLogger(__name__)
+
+
+class TimeLimited:
+    """Call ``fn(*args)`` in a forked child process, at most ``seconds`` per call.
+
+    A call past the limit kills the child and raises :class:`TimeoutError`; the next
+    call forks a new one.  An exception inside ``fn`` is raised in the caller as
+    :class:`RuntimeError` naming it; a child that dies raises :class:`ChildProcessError`.
+    Arguments and results travel by pickle.  Use it as a context manager, so that the
+    child ends with the work that needed it.
+
+    Parameters
+    ----------
+    fn : callable
+        The routine; it must be reachable in the child, which a fork guarantees.
+    seconds : float
+        Wall-clock limit of one call, > 0.
+
+    Examples
+    --------
+    >>> from lmi_suspension.mu.timelimit import TimeLimited
+    >>> with TimeLimited(divmod, seconds=5.0) as call:
+    ...     call(7, 2)
+    (3, 1)
+    """
+
+    def __init__(self, fn, seconds: float):
+        if not seconds > 0:
+            raise ValueError(f"seconds must be > 0, got {seconds!r}")
+        self.fn = fn
+        self.seconds = float(seconds)
+        self._pid = None
+        self._conn = None
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def __call__(self, *args):
+        if not hasattr(os, "fork"):
+            return self.fn(*args)
+        if self._pid is None:
+            self._start()
+        try:
+            self._conn.send(args)
+            ready = self._conn.poll(self.seconds)
+        except (BrokenPipeError, EOFError, OSError) as exc:
+            self._kill()
+            raise ChildProcessError(f"the child running {self._name} died: {exc}") from None
+        if not ready:
+            self._kill()
+            raise TimeoutError(f"{self._name} did not return within {self.seconds:g} s")
+        try:
+            status, value = self._conn.recv()
+        except (EOFError, OSError) as exc:
+            self._kill()
+            raise ChildProcessError(f"the child running {self._name} died: {exc}") from None
+        if status == "error":
+            raise RuntimeError(f"{self._name} raised {value}")
+        return value
+
+    def close(self):
+        """End the child (if any); the object can be called again afterwards."""
+        if self._pid is None:
+            return
+        self._conn.close()          # the child reads EOF and exits
+        try:
+            os.waitpid(self._pid, 0)
+        except ChildProcessError:
+            pass
+        self._pid = self._conn = None
+
+    @property
+    def _name(self):
+        return getattr(self.fn, "__name__", repr(self.fn))
+
+    def _start(self):
+        parent, child = Pipe()
+        pid = os.fork()
+        if pid == 0:                # the child: serve calls until the pipe closes
+            try:
+                parent.close()
+                _serve(self.fn, child)
+            finally:
+                os._exit(0)         # never run the parent's cleanup or atexit code
+        child.close()
+        self._pid, self._conn = pid, parent
+
+    def _kill(self):
+        try:
+            os.kill(self._pid, signal.SIGKILL)
+        except ProcessLookupError:
+            pass
+        try:
+            os.waitpid(self._pid, 0)
+        except ChildProcessError:
+            pass
+        self._conn.close()
+        self._pid = self._conn = None
+
+
+def _serve(fn, conn):
+    while True:
+        try:
+            args = conn.recv()
+        except (EOFError, OSError):
+            return
+        try:
+            reply = ("ok", fn(*args))
+        except Exception as exc:            # reported to the caller, which decides
+            reply = ("error", repr(exc))
+        conn.send(reply)
