@@ -296,6 +296,23 @@ def test_ab13md_failure_falls_back_to_the_lmi(monkeypatch, caplog, failure):
     assert "LMI bound was used there" in caplog.text
 
 
+def test_ab13md_warm_start_has_slycots_layout():
+    """The warm start built from one log scaling per block is what AB13MD itself
+    returns as ``x`` after a cold call (its D part: squared scalings relative to the
+    first block), from the D that call returned."""
+    slycot = pytest.importorskip("slycot")
+    from lmi_suspension.mu.bounds import _ab13md_x0
+
+    nblock, itype = np.array([1, 1, 2, 1, 1]), np.array([1, 1, 2, 2, 2])
+    _, d, _, x = slycot.ab13md(AB13MD_Z, nblock, itype)
+    starts = np.cumsum(nblock) - nblock
+    x0 = _ab13md_x0(np.log(np.asarray(d)[starts]), itype)
+    m = nblock.size
+    assert x0.shape == x.shape
+    np.testing.assert_allclose(x0[:m - 1], x[:m - 1], rtol=1e-9)
+    assert np.all(x0[m - 1:] == 0)
+
+
 @pytest.mark.parametrize("slow", ["cold call", "every call"])
 def test_ab13md_that_does_not_return_is_stopped(monkeypatch, caplog, slow):
     """AB13MD's loops have no iteration bound (one cold call on the seat took 63 s, a

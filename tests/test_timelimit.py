@@ -57,3 +57,46 @@ def test_close_ends_the_child():
 def test_a_limit_that_is_not_positive_is_refused(seconds):
     with pytest.raises(ValueError, match="seconds"):
         TimeLimited(os.getpid, seconds=seconds)
+
+
+def test_closing_one_does_not_wait_for_another_ones_child():
+    """A child forked by one ``TimeLimited`` inherits the other's pipe, which then never
+    reads EOF: closing must not wait for the child to notice (it is killed)."""
+    a, b = TimeLimited(os.getpid, seconds=5.0), TimeLimited(os.getpid, seconds=5.0)
+    a(), b()
+    t0 = time.perf_counter()
+    a.close()
+    assert time.perf_counter() - t0 < 2.0
+    b.close()
+
+
+def test_an_interrupted_call_leaves_no_stale_reply():
+    """A call interrupted in the parent (here by a timer signal, as by Ctrl-C) is still
+    running in the child: the next call must not read its reply, and closing must not
+    wait for it."""
+    import signal
+
+    class Interrupted(Exception):
+        pass
+
+    def interrupt(*_):
+        raise Interrupted
+
+    old = signal.signal(signal.SIGALRM, interrupt)
+    try:
+        with TimeLimited(_sleep_then, seconds=30.0) as call:
+            signal.setitimer(signal.ITIMER_REAL, 0.3)
+            with pytest.raises(Interrupted):
+                call(3.0, "stale")
+            t0 = time.perf_counter()
+            assert call(0.0, "fresh") == "fresh"
+            assert time.perf_counter() - t0 < 2.0
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old)
+
+
+def test_an_unpicklable_result_is_an_error_naming_it():
+    with TimeLimited(lambda: (lambda: None), seconds=5.0) as call:
+        with pytest.raises(RuntimeError, match="pickle|Pickl"):
+            call()

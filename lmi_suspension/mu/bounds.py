@@ -12,7 +12,10 @@ Upper bound (per frequency)
       blocks and single real or complex scalars.  Its scalings are re-checked with numpy like the
       LMI's (the returned bound is the generalized eigenvalue they certify), and a
       frequency where AB13MD fails or its scalings do not confirm its value falls back
-      to ``"lmi"``.  On the seat's occupant structure (one complex and seven real
+      to ``"lmi"``.  AB13MD's loops have no iteration bound, so each call runs in a
+      forked child process under a limit of 20 s (:mod:`.timelimit`); a call past it is
+      started again from the Perron scaling, and past that the frequency falls back to
+      ``"lmi"`` as well.  On the seat's occupant structure (one complex and seven real
       scalars, 11 × 11) it took 10–20 ms against 3–9 s per frequency and agreed with
       ``"lmi"`` to 1e-6 where the LMI iteration converged; below 2 rad/s, where
       ``‖M‖`` is about 45, the LMI iteration stalled at its starting value (1.397
@@ -64,7 +67,8 @@ _METHODS = ("auto", "fast", "lmi", "ab13md")
 _AB13MD_CONFIRM = 1e-6
 #: wall-clock limit of one AB13MD call, in seconds.  Cold calls on the seat's set loops
 #: took 6–130 ms, with two outliers on the µ controller's loop: 4.1 s and 63 s
-#: (2026-11-27, :mod:`.timelimit`); the limit leaves the 4 s call a 5× slower machine.
+#: (2026-11-27, :mod:`.timelimit`); the limit leaves the 4.1 s call room on a machine
+#: four times slower.
 _AB13MD_SECONDS = 20.0
 
 
@@ -550,6 +554,13 @@ def _ab13md_call(Z, nblock, itype, x):
     return bound, d, g
 
 
+def _ab13md_x0(logd, itype):
+    """AB13MD's warm start ``X`` from one log scaling per block (``D M D⁻¹``): the
+    squared scalings relative to the first block, then one G entry per real block (0)."""
+    logd = np.asarray(logd, dtype=float)
+    return np.concatenate([np.exp(2.0 * (logd[1:] - logd[0])), np.zeros(np.sum(itype == 1))])
+
+
 def _ab13md_upper(M, blocks, call, logd0):
     """AB13MD's D-G bound of ``M`` with its scalings ``(X, X, G)``, the bound being the
     one those scalings certify (:func:`_certify`); ``(inf, None)`` where AB13MD fails or
@@ -567,8 +578,7 @@ def _ab13md_upper(M, blocks, call, logd0):
     word for the structure."""
     nblock, itype = blocks
     Mc = np.asarray(M, dtype=complex)
-    # AB13MD's warm start: squared scalings relative to the first block, then G (zero)
-    x0 = np.concatenate([np.exp(2.0 * (logd0[1:] - logd0[0])), np.zeros(np.sum(itype == 1))])
+    x0 = _ab13md_x0(logd0, itype)
     try:
         try:
             bound, d, g = call(Mc, nblock, itype, None)
@@ -924,7 +934,8 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
         otherwise; ``"fast"`` on other structures raises
         :class:`~lmi_suspension.errors.InputError`.  ``"ab13md"`` computes the D-G
         bound with SLICOT (square full blocks and single scalars only; a frequency
-        where it fails its certificate falls back to ``"lmi"``), two orders of
+        where it fails its certificate, or does not return within 20 s cold and
+        again from the Perron scaling, falls back to ``"lmi"``), two orders of
         magnitude faster on mixed structures and, where the LMI iteration stalls,
         tighter (see the module's notes).
     omega : array_like, optional

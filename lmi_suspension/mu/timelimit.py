@@ -8,17 +8,20 @@ start from the neighbouring frequency did not return in 300 s (2026-11-27).  A F
 loop cannot be interrupted from Python, so the call runs in a child process that is
 killed when the limit passes, and the caller falls back to a route that has a bound.
 
-The child is forked once, on the first call, and serves every later call through a
-pipe until :meth:`TimeLimited.close`; forking this package's process takes about 22 ms
+The child is forked on the first call (and again after a call it had to stop) and serves
+every later call through a pipe until :meth:`TimeLimited.close`, which kills it (it holds
+no state, and a call interrupted in the parent may still be running in it); forking this package's process takes about 22 ms
 (183 MB resident, this machine), a cold AB13MD call on the seat 6–20 ms.  Where
 ``os.fork`` does not exist (Windows), the routine runs in-process, without a limit.
 """
 
 from __future__ import annotations
 
+import ctypes
 import logging
 import os
 import signal
+import sys
 from multiprocessing import Pipe
 
 __all__ = ["TimeLimited"]
@@ -57,6 +60,7 @@ class TimeLimited:
         self.seconds = float(seconds)
         self._pid = None
         self._conn = None
+        self._busy = False      # a call was sent and its reply not read (interrupted)
 
     def __enter__(self):
         return self
@@ -67,9 +71,12 @@ class TimeLimited:
     def __call__(self, *args):
         if not hasattr(os, "fork"):
             return self.fn(*args)
+        if self._busy:          # the last call was interrupted: its reply would be read
+            self._kill()
         if self._pid is None:
             self._start()
         try:
+            self._busy = True
             self._conn.send(args)
             ready = self._conn.poll(self.seconds)
         except (BrokenPipeError, EOFError, OSError) as exc:
@@ -80,6 +87,7 @@ class TimeLimited:
             raise TimeoutError(f"{self._name} did not return within {self.seconds:g} s")
         try:
             status, value = self._conn.recv()
+            self._busy = False
         except (EOFError, OSError) as exc:
             self._kill()
             raise ChildProcessError(f"the child running {self._name} died: {exc}") from None
@@ -88,15 +96,13 @@ class TimeLimited:
         return value
 
     def close(self):
-        """End the child (if any); the object can be called again afterwards."""
-        if self._pid is None:
-            return
-        self._conn.close()          # the child reads EOF and exits
-        try:
-            os.waitpid(self._pid, 0)
-        except ChildProcessError:
-            pass
-        self._pid = self._conn = None
+        """End the child (if any); the object can be called again afterwards.
+
+        The child is killed, not asked to stop: a call interrupted in the parent (by
+        an exception or Ctrl-C) may still be running in it, and a child forked by
+        another ``TimeLimited`` holds a copy of this pipe, so that it never closes."""
+        if self._pid is not None:
+            self._kill()
 
     @property
     def _name(self):
@@ -104,15 +110,23 @@ class TimeLimited:
 
     def _start(self):
         parent, child = Pipe()
-        pid = os.fork()
+        try:
+            pid = os.fork()
+        except OSError:
+            parent.close()
+            child.close()
+            raise
         if pid == 0:                # the child: serve calls until the pipe closes
+            code = 1
             try:
                 parent.close()
+                _orphan_proof()
                 _serve(self.fn, child)
+                code = 0
             finally:
-                os._exit(0)         # never run the parent's cleanup or atexit code
+                os._exit(code)      # never run the parent's cleanup or atexit code
         child.close()
-        self._pid, self._conn = pid, parent
+        self._pid, self._conn, self._busy = pid, parent, False
 
     def _kill(self):
         try:
@@ -125,6 +139,18 @@ class TimeLimited:
             pass
         self._conn.close()
         self._pid = self._conn = None
+        self._busy = False
+
+
+def _orphan_proof():
+    """In the child: Ctrl-C is the parent's to handle, and on Linux the child dies with
+    its parent (a parent killed during a call would otherwise leave it spinning)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    if sys.platform.startswith("linux"):
+        try:
+            ctypes.CDLL(None).prctl(1, signal.SIGKILL)      # PR_SET_PDEATHSIG
+        except (OSError, AttributeError):
+            pass
 
 
 def _serve(fn, conn):
@@ -134,7 +160,6 @@ def _serve(fn, conn):
         except (EOFError, OSError):
             return
         try:
-            reply = ("ok", fn(*args))
-        except Exception as exc:            # reported to the caller, which decides
-            reply = ("error", repr(exc))
-        conn.send(reply)
+            conn.send(("ok", fn(*args)))
+        except BaseException as exc:        # reported to the caller, which decides
+            conn.send(("error", repr(exc)))

@@ -37,7 +37,7 @@ import control
 import numpy as np
 from scipy import linalg, optimize
 
-from ..errors import DimensionError, ParameterError
+from ..errors import DimensionError, InputError, ParameterError
 from .augmented import SeatDesignOptions, seat_augmented_plant
 from .model import seat_matrices
 from .params import SeatParameters
@@ -171,11 +171,11 @@ def loop_response(K, omega: np.ndarray, blocks) -> np.ndarray:
 
 def interconnection_poles(P, K, nw: int, nu: int, nz: int, ny: int) -> np.ndarray:
     """Poles of ``F_l(P, K)`` where ``P`` has ``nw + nu`` inputs and ``nz + ny``
-    outputs and ``D22 = 0``, as every seat plant here has (a nonzero ``D22`` is a
-    :class:`DimensionError`: the formula below would be wrong for it)."""
+    outputs and ``D22 = 0``, as every seat plant here has (a nonzero ``D22`` is an
+    :class:`InputError`: the formula below would be wrong for it)."""
     A, B, C = (np.asarray(m, dtype=float) for m in (P.A, P.B, P.C))
     if np.any(np.asarray(P.D, dtype=float)[nz:nz + ny, nw:nw + nu] != 0):
-        raise DimensionError("interconnection_poles needs D22 = 0")
+        raise InputError("interconnection_poles needs D22 = 0")
     B2, C2 = B[:, nw:nw + nu], C[nz:nz + ny]
     Ak, Bk, Ck, Dk = (np.asarray(m, dtype=float) for m in (K.A, K.B, K.C, K.D))
     return np.linalg.eigvals(np.block([[A + B2 @ Dk @ C2, B2 @ Ck], [Bk @ C2, Ak]]))
