@@ -22,6 +22,7 @@ import logging
 import os
 import signal
 import sys
+import warnings
 from multiprocessing import Pipe
 
 __all__ = ["TimeLimited"]
@@ -83,6 +84,7 @@ class TimeLimited:
             self._kill()
             raise ChildProcessError(f"the child running {self._name} died: {exc}") from None
         if not ready:
+            logger.debug("%s: killing child %d after %g s", self._name, self._pid, self.seconds)
             self._kill()
             raise TimeoutError(f"{self._name} did not return within {self.seconds:g} s")
         try:
@@ -111,7 +113,14 @@ class TimeLimited:
     def _start(self):
         parent, child = Pipe()
         try:
-            pid = os.fork()
+            with warnings.catch_warnings():
+                # Python 3.12+ warns on every fork of a process with threads (here
+                # OpenBLAS's pool); the child only runs ``fn``, already imported, and the
+                # C libraries it calls into (glibc's malloc, OpenBLAS) reset their locks
+                # at fork
+                warnings.filterwarnings("ignore", message=r".*fork\(\) may lead to deadlocks",
+                                        category=DeprecationWarning)
+                pid = os.fork()
         except OSError:
             parent.close()
             child.close()
