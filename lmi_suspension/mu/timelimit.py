@@ -2,17 +2,20 @@
 
 Why a process: SLICOT's AB13MD (the mixed-µ upper bound :func:`~lmi_suspension.mu.mussv`
 takes by default) has loops without an iteration bound, its Osborne balancing and its
-barrier iteration.  On the seat's µ controller, one call at 1.6e-3 rad/s took 63 s
-(the other 103 calls of the same grid took 6–130 ms), and the same matrix with a warm
-start from the neighbouring frequency did not return in 300 s (2026-11-27).  A Fortran
-loop cannot be interrupted from Python, so the call runs in a child process that is
-killed when the limit passes, and the caller falls back to a route that has a bound.
+barrier iteration.  On the seat's µ controller's set loop, 104 calls of one grid took
+118.9 s: two calls on one matrix (a split point below the grid, ‖M‖ = 35) took 63 s and
+46 s, two on another 4.1 s each, the other 100 calls 6–130 ms; the matrix at 1.585e-3
+rad/s, warm-started from the neighbouring frequency, did not return in 300 s
+(2026-11-27).  A Fortran loop cannot be interrupted from Python, so the call runs in a
+child process that is killed when the limit passes, and the caller falls back to a
+route that has a bound.
 
-The child is forked on the first call (and again after a call it had to stop) and serves
-every later call through a pipe until :meth:`TimeLimited.close`, which kills it (it holds
-no state, and a call interrupted in the parent may still be running in it); forking this package's process takes about 22 ms
-(183 MB resident, this machine), a cold AB13MD call on the seat 6–20 ms.  Where
-``os.fork`` does not exist (Windows), the routine runs in-process, without a limit.
+The child is forked on the first call (and again after a call it had to stop) and
+serves every later call through a pipe until :meth:`TimeLimited.close`, which kills it:
+it holds no state, and a call interrupted in the parent may still be running in it.
+Forking this package's process takes about 22 ms (183 MB resident, this machine), a
+call through the pipe 0.7 ms more than in-process.  Where ``os.fork`` does not exist
+(Windows), the routine runs in-process, without a limit.
 """
 
 from __future__ import annotations
