@@ -23,6 +23,7 @@ from lmi_suspension.seat.sampled import discretise_controller, simulate_sampled
 from lmi_suspension.sweep import read_results
 from lmi_suspension.seat import (
     SeatDesignOptions,
+    SeatParameters,
     bump,
     bump_limit,
     closed_loop_stable,
@@ -36,7 +37,7 @@ EXPECTED_PNGS = {
     "fig11_bump_u_applied.png", "fig12_noise_z3dd.png", "fig13_noise_x1.png",
     "fig14_noise_u_applied.png", "fig15_mu_bounds.png", "peak_vs_delay.png", "iso_C_z3dd.png",
     "force_commanded_vs_applied.png", "mu_bounds_constrained.png", "mu_bounds_refined.png",
-    "tradeoff_refined.png",
+    "tradeoff_refined.png", "occupant_map.png", "worst_case.png",
 }
 #: the stand-in of the shipped constrained controller: a weaker low-passed stiffness
 K_CONSTRAINED = control.ss([[-150.0]], [[150.0, 0.0]], [[4000.0]], [[0.0, 500.0]])
@@ -44,9 +45,11 @@ K_CONSTRAINED = control.ss([[-150.0]], [[150.0, 0.0]], [[4000.0]], [[0.0, 500.0]
 FAST_POLE = 5000.0
 #: the stand-in of the shipped refined controller: another low-passed stiffness
 K_REFINED = control.ss([[-250.0]], [[250.0, 0.0]], [[6000.0]], [[0.0, 800.0]])
+#: the stand-in of the shipped controller for every occupant (the one exported)
+K_OCCUPANTS = control.ss([[-180.0]], [[180.0, 0.0]], [[9000.0]], [[0.0, 1200.0]])
 
 
-def _stand_in(fail_riccati=False):
+def _stand_in(fail_riccati=False, fail_occupants=False):
     # Low-passed extra stiffness on x1 and a little on x3: a stable loop with a finite
     # delay margin, unlike any µ design, so wrong wiring shows up in the numbers.
     K_mu = control.ss([[-200.0]], [[200.0, 0.0]], [[15000.0]], [[0.0, 2000.0]])
@@ -92,6 +95,12 @@ def _stand_in(fail_riccati=False):
         Kd = discretise_controller(K_REFINED, 1e-3)
         return K_REFINED, Kd, {"description": "stand-in refined", "u_bound": 1500.0}
 
+    def load_occupants():
+        if fail_occupants:
+            raise OSError("stand-in: mu_occupants.json missing")
+        Kd = discretise_controller(K_OCCUPANTS, 1e-3)
+        return K_OCCUPANTS, Kd, {"description": "stand-in occupants", "u_bound": 1500.0}
+
     def load_refined_tradeoff():
         calls.append("tradeoff")
         points = tuple(SimpleNamespace(u_bound=b, mu_peak=0.98, bump_peak=(p, p + 0.3),
@@ -112,6 +121,7 @@ def _stand_in(fail_riccati=False):
                           analyse_uncertainty=analyse_uncertainty,
                           load_constrained=load_constrained,
                           load_refined=load_refined,
+                          load_occupants=load_occupants,
                           load_refined_tradeoff=load_refined_tradeoff,
                           certify_constrained=certify_constrained,
                           DEFAULT_DESIGN=SeatDesignOptions(), DEFAULT_MUSYN=None)
@@ -190,12 +200,40 @@ def test_summary_has_every_controller_and_delay(run):
     rows = read_results(run.out / "monte_carlo")[0].to_pylist()
     assert [r["peak_z3dd"] for r in rows] == mc["peak_z3dd"]
     assert mc["worst"]["peak_z3dd"] == max(mc["peak_z3dd"]) and mc["sweep"]["failed"] == 0
+    # the worst sample against its own limit: the LP of its seat, solved here
+    w = mc["worst"]
+    seat = SeatParameters(m3=w["m3"], k1=w["k1"], k2=w["k2"], k3=w["k3"])
+    own = bump_limit(bump(t_end=R._QUICK.bump_t_end, dt=R._QUICK.road_dt), seat,
+                     dt=R._QUICK.limit_dt).certified_peak
+    assert mc["worst_own_limit"] == pytest.approx(own, rel=1e-6)
+    assert mc["worst_ratio_to_own_limit"] == pytest.approx(w["peak_z3dd"] / own, rel=1e-6)
     assert all(30.0 <= r["m3"] <= 70.0 and 0.0 <= r["delay"] <= 0.025 for r in rows)
 
 
 @pytest.mark.slow
-def test_controller_json_round_trips_exactly(run):
+def test_controller_json_is_the_controller_for_every_occupant(run):
     K, meta = load_controller(run.out / "controller.json")
+    for name in "ABCD":
+        assert np.array_equal(np.asarray(getattr(K, name)), np.asarray(getattr(K_OCCUPANTS, name)))
+    assert list(K.input_labels) == ["x1", "x3"] and list(K.output_labels) == ["u"]
+    assert meta["exported_as"] == "mu_occupants" and meta["version"]
+    assert meta["description"] == "stand-in occupants"
+    # re-certified in this run (the stand-in certificate's µ)
+    assert meta["certified_here"] == {"mu_peak_upper": 1.2, "mu_peak_lower": 1.1}
+    data = json.loads((run.out / "summary.json").read_text())
+    assert data["exported"] == "mu_occupants"
+    # the Monte-Carlo ran on it: one of its rows recomputed with K_OCCUPANTS
+    row = read_results(run.out / "monte_carlo")[0].to_pylist()[0]
+    seat = SeatParameters(m3=row["m3"], k1=row["k1"], k2=row["k2"], k3=row["k3"])
+    road = bump(t_end=R._QUICK.bump_t_end, dt=1e-3)
+    direct = simulate(K_OCCUPANTS, road, delay=row["delay"], params=seat,
+                      dt=R._QUICK.sim_dt).metrics()
+    assert row["peak_z3dd"] == pytest.approx(direct.peak_z3dd, rel=1e-9)
+
+
+@pytest.mark.slow
+def test_mu_design_file_round_trips_exactly(run):
+    K, meta = load_controller(run.out / "controllers" / "mu.json")
     for name in "ABCD":
         assert np.array_equal(np.asarray(getattr(K, name)), np.asarray(getattr(run.K, name)))
     assert list(K.input_labels) == ["x1", "x3"] and list(K.output_labels) == ["u"]
@@ -209,7 +247,7 @@ def test_controller_json_round_trips_exactly(run):
 def test_every_controller_file_holds_both_realizations(run):
     from lmi_suspension.io import load_discrete_controller
 
-    for name in ("mu", "mu_constrained", "mu_refined"):
+    for name in ("mu", "mu_constrained", "mu_refined", "mu_occupants"):
         K, _ = load_controller(run.out / "controllers" / f"{name}.json")
         Kd, meta = load_discrete_controller(run.out / "controllers" / f"{name}.json")
         assert Kd.dt == 1e-3 and meta["fastest_pole"] > 0
@@ -221,6 +259,88 @@ def test_every_controller_file_holds_both_realizations(run):
     K, meta = load_controller(run.out / "controllers" / "mu_refined.json")
     assert np.array_equal(np.asarray(K.D), np.asarray(K_REFINED.D))
     assert meta["description"] == "stand-in refined"
+
+
+@pytest.mark.slow
+def test_occupant_map_is_what_direct_computations_give(run):
+    """The map of controller.json over m3 × k1: every cell's stability by the Nyquist
+    count, called here directly; the worst cell in the set recomputed from its own limit
+    (the LP) and a direct simulation; the figure shows the same seat."""
+    data = json.loads((run.out / "summary.json").read_text())
+    grid = data["occupant_map"]
+    rows = read_results(run.out / "occupant_map")[0].to_pylist()
+    cfg = R._QUICK
+    assert grid["cells"] == len(rows) == len(cfg.map_m3) * len(cfg.map_k1_rel) * len(
+        cfg.map_delays)
+    p0 = SeatParameters()
+    assert sorted({r["k1"] for r in rows}) == pytest.approx(
+        sorted(p0.k1 * (1 + x) for x in cfg.map_k1_rel), rel=1e-12)
+    unstable = [not closed_loop_stable(K_OCCUPANTS, r["delay"],
+                                       SeatParameters(m3=r["m3"], k1=r["k1"])) for r in rows]
+    assert grid["unstable_cells"] == sum(unstable)
+    inside = [r for r in rows if 30.0 <= r["m3"] <= 70.0
+              and 0.8 * p0.k1 * (1 - 1e-12) <= r["k1"] <= 1.2 * p0.k1 * (1 + 1e-12)]
+    # the quick grid's set cells: m3 30 and 70 at k1 nominal and +20 %
+    assert len(inside) == 4
+    w = grid["worst_in_set"]
+    assert w["limit_ratio"] == max(r["limit_ratio"] for r in inside)
+    seat = SeatParameters(m3=w["m3"], k1=w["k1"])
+    road = bump(t_end=cfg.map_t_end, dt=1e-3)
+    own = bump_limit(road, seat, dt=2e-3).certified_peak
+    direct = simulate(K_OCCUPANTS, road, delay=w["delay"], params=seat, dt=cfg.map_step)
+    assert w["limit_ratio"] == pytest.approx(np.max(np.abs(direct.z3dd)) / own, rel=1e-9)
+    table = R.comparison_table(run.summary)
+    assert "controller.json (µ, every occupant)" in table
+    assert f"{w['limit_ratio']:.2f} × its own limit" in table
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("stiffness_rel", [0.2, 0.6])
+def test_occupant_map_finds_the_shipped_controllers_stability_boundary(
+        monkeypatch, tmp_path, stiffness_rel):
+    """The shipped controller for every occupant loses stability with the seat spring
+    50 % soft (a fact measured by the Nyquist count, called here directly).  With the
+    set's ±20 % that cell lies outside the set; widened to ±60 % (patched), the cell
+    is in the set and is its worst case, reported as unstable."""
+    import dataclasses
+    import shutil
+
+    from lmi_suspension.seat import occupants
+    from lmi_suspension.seat.multimodel import SHIPPED_OCCUPANTS
+
+    path = tmp_path / "controller.json"
+    shutil.copy(SHIPPED_OCCUPANTS, path)
+    K, _ = load_controller(path)
+    cfg = dataclasses.replace(R._QUICK, map_m3=(30.0,), map_k1_rel=(-0.5, 0.0))
+    soft = SeatParameters(m3=30.0, k1=0.5 * SeatParameters().k1)
+    assert not closed_loop_stable(K, 0.025, soft)
+    assert closed_loop_stable(K, 0.025, SeatParameters(m3=30.0))
+    original = occupants.OccupantSet
+    monkeypatch.setattr(occupants, "OccupantSet", lambda nominal: original(
+        nominal=nominal, stiffness_rel=stiffness_rel))
+    entry, table, _spec, worst = R._occupant_map(path, cfg, SeatParameters(), seed=0)
+    assert entry["cells"] == 2 and entry["unstable_cells"] == 1
+    if stiffness_rel == 0.2:
+        assert entry["unstable_cells_in_set"] == 0 and worst["k1"] == SeatParameters().k1
+        assert worst["limit_ratio"] > 1
+    else:
+        assert entry["unstable_cells_in_set"] == 1 and worst["k1"] == soft.k1
+        assert R._map_worst_text(entry["worst_in_set"]).startswith("unstable at m3 30 kg")
+
+
+@pytest.mark.slow
+def test_controller_json_falls_back_to_the_mu_design_and_says_so(monkeypatch, tmp_path):
+    api, K_mu, *_ = _stand_in(fail_occupants=True)
+    monkeypatch.setattr(R, "_design_api", lambda: api)
+    summary = R.reproduce(tmp_path, rng=np.random.default_rng(0), delays=(0.0,), quick=True)
+    K, meta = load_controller(tmp_path / "controller.json")
+    assert np.array_equal(np.asarray(K.D), np.asarray(K_mu.D)) and meta["exported_as"] == "mu"
+    assert meta["mu_peak_upper"] == summary.mu_peak
+    fact = [f for f in summary.facts if f.startswith("controller.json holds")]
+    assert len(fact) == 1 and "mu_occupants.json missing" in fact[0]
+    assert "OSError" in summary.controller("mu_occupants").error
+    data = json.loads((tmp_path / "summary.json").read_text())
+    assert data["exported"] == "mu" and data["occupant_map"]["cells"] == 6
 
 
 def _bump_at_25ms(K):

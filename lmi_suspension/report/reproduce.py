@@ -4,6 +4,12 @@
 7–15 of the paper plus the peak-versus-delay study), ``summary.json`` and ``controller.json``
 into one directory. :func:`comparison_table` formats the headline figures as text.
 
+``controller.json`` is the shipped controller for every occupant (30–70 kg, springs and
+dampers ±20 %, delay 0–25 ms; :data:`~lmi_suspension.seat.multimodel.SHIPPED_OCCUPANTS`),
+not this run's µ design: the µ design goes unstable once the seat spring is about 17 %
+soft (issue 38), and a user who takes the run's controller takes it to a seat that is not
+the nominal one.  The µ design is ``controllers/mu.json``.
+
 Deviation from the paper, on purpose: the white-noise floor velocity has a two-sided PSD of
 ``1e-4`` (m/s)²/Hz in a 50 Hz band (about the level of an ISO 8608 class-C road at 30 km/h),
 not the paper's unit PSD, which would be a floor velocity of about 10 m/s RMS and keep the
@@ -39,17 +45,24 @@ logger = logging.getLogger(__name__)
 
 #: Names of the compared controllers, in table order.
 CONTROLLER_NAMES = ("passive", "hinf_lmi_nominal", "hinf_riccati", "mu", "mu_constrained",
-                    "mu_refined")
+                    "mu_refined", "mu_occupants")
+#: the controller written to ``controller.json`` (the one ``simulate``, ``sweep`` and a
+#: user take): the shipped design for every occupant, spring and delay of the set
+#: (:data:`~lmi_suspension.seat.multimodel.SHIPPED_OCCUPANTS`); the µ design where it
+#: cannot be loaded (the summary's facts then say so)
+EXPORTED = "mu_occupants"
 #: the stages of :func:`reproduce`, in order: each announces itself with one progress
 #: message that does not start with a space (details follow indented), and its wall time
 #: is ``summary.json``'s ``timings[name]``
-STAGES = ("mu_design", "mu_analysis", "mu_constrained", "mu_refined", "hinf_lmi_nominal",
-          "hinf_riccati",
+STAGES = ("mu_design", "mu_analysis", "mu_constrained", "mu_refined", "mu_occupants",
+          "hinf_lmi_nominal", "hinf_riccati",
           "limit",
-          *(f"simulate_{n}" for n in CONTROLLER_NAMES), "iso_C", "monte_carlo", "figures")
+          *(f"simulate_{n}" for n in CONTROLLER_NAMES), "iso_C", "monte_carlo",
+          "occupant_map", "figures")
 _LONG_NAMES = {"passive": "passive", "hinf_lmi_nominal": "H∞ LMI (no delay)",
                "hinf_riccati": "H∞ Riccati", "mu": "µ (D-K)",
-               "mu_constrained": "µ, hard bounds", "mu_refined": "µ, refined"}
+               "mu_constrained": "µ, hard bounds", "mu_refined": "µ, refined",
+               "mu_occupants": "µ, every occupant"}
 #: sample time of every controller's discrete realization in controllers/<name>.json
 _SAMPLE_TIME = 1e-3
 
@@ -68,14 +81,32 @@ class _Settings:
     sim_dt: float
     limit_dt: float
     mc_n: int
-    #: Dask workers of the Monte-Carlo sweep (0: in this process)
+    #: Dask workers of the Monte-Carlo sweep and of the occupant map (0: in this process)
     mc_workers: int
+    #: the occupant map's grid: m3 (kg), k1 relative to Table 1, delays (s), and its
+    #: simulation step (s)
+    map_m3: tuple
+    map_k1_rel: tuple
+    map_delays: tuple
+    map_step: float
+    map_t_end: float
 
 
+# The map reaches past the set (m3 30-70 kg, k1 ±20 %) far enough to show where the
+# exported controller loses stability: a seat spring 40-50 % soft (measured 2026-11-28 at
+# delays 0, 12.5 and 25 ms, every m3 of the grid).  Its size keeps reproduce within 2
+# minutes: 63 seats × 3 delays of 3 s records took 46 s of a 118 s run on this 2-core
+# machine (0.15 s a case, 0.6 s a seat for its limit LP), so the grid is 49 seats × the
+# two end delays, on 1.5 s records: the bump is over in 0.24 s, and each limit was the
+# same to 1e-9 on 1.5 s as on 3 s (seats 30/70/43.3 kg on k1 -20/+20/0 %) in half the time.
 _FULL = _Settings(bump_t_end=3.0, noise_t_end=3.0, iso_t_end=3.0, road_dt=1e-3, sim_dt=2e-4,
-                  limit_dt=2e-3, mc_n=64, mc_workers=2)
+                  limit_dt=2e-3, mc_n=64, mc_workers=2,
+                  map_m3=(20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0),
+                  map_k1_rel=(-0.5, -0.4, -0.3, -0.2, 0.0, 0.2, 0.3),
+                  map_delays=(0.0, 0.025), map_step=5e-4, map_t_end=1.5)
 _QUICK = _Settings(bump_t_end=1.5, noise_t_end=1.0, iso_t_end=1.0, road_dt=1e-3, sim_dt=5e-4,
-                   limit_dt=5e-3, mc_n=4, mc_workers=0)
+                   limit_dt=5e-3, mc_n=4, mc_workers=0, map_m3=(30.0, 70.0),
+                   map_k1_rel=(-0.5, 0.0, 0.2), map_delays=(0.025,), map_step=5e-4, map_t_end=1.5)
 
 
 #: the Monte-Carlo's uncertainty set: m3 over the paper's occupants, each stiffness ±20 %
@@ -108,6 +139,14 @@ def _monte_carlo(controller: Path, cfg: _Settings, delay_range, params, seed: in
     rows = read_results(out)[0].to_pylist()
     score = [r["peak_z3dd"] if r["stable"] and r["stable_sim"] else math.inf for r in rows]
     worst = rows[int(np.argmax(score))]
+    own = math.nan
+    if math.isfinite(score[int(np.argmax(score))]):
+        # the worst sample against its own limit too (one LP: the seat differs from the
+        # nominal one whose limit the samples are divided by)
+        from ..seat import bump_limit
+
+        seat = dataclasses.replace(params, **{k: worst[k] for k in ("m3", "k1", "k2", "k3")})
+        own = bump_limit(road, seat, dt=cfg.limit_dt).certified_peak
     return {
         "n": cfg.mc_n, "m3_range": list(_MC_M3), "stiffness_rel": _MC_STIFFNESS_REL,
         "delay_range": [float(d) for d in delay_range], "seed": seed,
@@ -115,10 +154,63 @@ def _monte_carlo(controller: Path, cfg: _Settings, delay_range, params, seed: in
         "delays": [r.get("delay", float(delay_range[0])) for r in rows],
         "worst": {k: v for k, v in worst.items() if k not in ("controller", "seconds")},
         "worst_ratio_to_limit": worst["peak_z3dd"] / nominal_limit,
+        "worst_own_limit": own, "worst_ratio_to_own_limit": worst["peak_z3dd"] / own,
         # (its wall time is the stage's, in "timings")
         "sweep": {"workers": res.workers, "failed": res.n_failed,
                   "table": "monte_carlo/results.parquet"},
     }
+
+
+def _occupant_map(controller: Path, cfg: _Settings, params, seed: int) -> tuple:
+    """The exported controller over occupant mass × seat spring: a grid sweep
+    (:mod:`lmi_suspension.sweep`, ``cfg.mc_workers`` Dask workers) of ``m3`` × ``k1`` ×
+    delay on the bump, each cell's peak ``|z̈3|`` over *its own* physical limit (the LP of
+    :func:`~lmi_suspension.seat.bump_limit` for that seat) and its exact-delay stability.
+    The table goes to ``occupant_map/``.  Returns ``(entry, table, spec, worst)``: the
+    summary's ``occupant_map`` entry, the sweep's table and spec, and the worst row inside
+    the set (the unstable one if any, else the largest ratio)."""
+    from ..seat.occupants import OccupantSet
+    from ..sweep import SweepSpec, read_results, run_sweep
+
+    ranges = dict((n, (lo, hi)) for n, lo, hi in OccupantSet(nominal=params).ranges())
+    k1_values = tuple(params.k1 * (1 + r) for r in cfg.map_k1_rel)
+    spec = SweepSpec(controllers=(str(controller),),
+                     grid=(("m3", cfg.map_m3), ("k1", k1_values), ("delay", cfg.map_delays)),
+                     road="bump", duration=cfg.map_t_end, seed=seed, limit=True,
+                     step=cfg.map_step)
+    out = controller.parent / "occupant_map"
+    if out.exists():
+        shutil.rmtree(out)
+    # its figure is drawn by the caller, with the set's box
+    res = run_sweep(spec, out, workers=cfg.mc_workers, figures=False)
+    table = read_results(out)[0]
+    rows = table.to_pylist()
+
+    def inside(r):  # a relative tolerance: the grid's k1 are products of floats
+        return all(lo * (1 - 1e-9) <= r[n] <= hi * (1 + 1e-9)
+                   for n, (lo, hi) in ranges.items() if n in ("m3", "k1"))
+
+    def failed(r):
+        return r["error"] is not None or not (r["stable"] and r["stable_sim"])
+
+    in_set = [r for r in rows if inside(r)]
+    unstable_in = [r for r in in_set if failed(r)]
+    scored = [r for r in in_set if not failed(r) and math.isfinite(r["limit_ratio"] or math.nan)]
+    worst = unstable_in[0] if unstable_in else (
+        max(scored, key=lambda r: r["limit_ratio"]) if scored else None)
+    keep = ("m3", "k1", "delay", "stable", "stable_sim", "peak_z3dd", "limit_peak",
+            "limit_ratio", "peak_u", "peak_x1", "error")
+    entry = {
+        "grid": {"m3": list(cfg.map_m3), "k1": list(k1_values), "delay": list(cfg.map_delays)},
+        "set": {"m3": list(ranges["m3"]), "k1": list(ranges["k1"])},
+        "step": cfg.map_step, "cells": len(rows),
+        "unstable_cells": sum(failed(r) for r in rows),
+        "unstable_cells_in_set": len(unstable_in),
+        "worst_in_set": None if worst is None else {k: worst[k] for k in keep},
+        "sweep": {"workers": res.workers, "failed": res.n_failed,
+                  "table": "occupant_map/results.parquet"},
+    }
+    return entry, table, spec, worst
 
 
 @dataclass(frozen=True)
@@ -228,9 +320,10 @@ def _design_api():
     """The seat designs (imported late: they are heavy, and tests replace them)."""
     from types import SimpleNamespace
 
-    from ..seat import constrained, design, refine
+    from ..seat import constrained, design, multimodel, refine
     return SimpleNamespace(
         load_refined=refine.load_refined,
+        load_occupants=lambda: refine.load_refined(multimodel.SHIPPED_OCCUPANTS),
         load_refined_tradeoff=refine.load_refined_tradeoff,
         design_mu_controller=design.design_mu_controller,
         analyse_uncertainty=design.analyse_uncertainty,
@@ -305,13 +398,21 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     bump and white-noise simulations of every controller at every delay with the exact
     delay and saturation; linear stability (Nyquist, exact delay) at each delay and the
     delay margin of each controller; an ISO 8608 class-C road at 30 km/h at the smallest and
-    largest delay; a seeded Monte-Carlo over occupant mass and stiffnesses with delays drawn
-    from ``[0, max(delays)]`` for the µ controller (worst case reported).
+    largest delay; for the exported controller (``controller.json``), a seeded Monte-Carlo
+    over occupant mass and stiffnesses with delays drawn from ``[0, max(delays)]`` (worst
+    case reported) and the occupant map: a grid sweep of ``m3`` × ``k1`` reaching past the
+    set, each cell's worst peak over its own physical limit at the smallest and largest
+    delay and its exact-delay stability, with the worst seat in the set simulated.
 
     Files written: ``fig07_bump.png`` … ``fig15_mu_bounds.png`` (the paper's figures),
     ``peak_vs_delay.png``, ``iso_C_z3dd.png``, ``summary.json`` (non-finite numbers are
     written as ``null``; a ``null`` delay margin means no loss of stability below 1 s) and
-    ``controller.json`` (the µ controller, ``y = [x1, x3]`` in m to ``u`` in N);
+    ``controller.json`` (the controller for every occupant, ``y = [x1, x3]`` in m to ``u``
+    in N, re-certified here; the µ design only where the shipped file cannot be loaded,
+    which the summary's facts then say) and ``controller.mat``;
+    ``occupant_map.png`` (its map, the set's box and the stability boundary drawn),
+    ``occupant_map/`` (the map's sweep table), ``worst_case.png`` (the worst seat of the
+    map in the set, on the bump: ``z̈3`` against that seat's own limit, force, stroke);
     ``controllers/<name>.json`` for every designed controller, each with its 1 kHz
     discrete realization (``Ad``, ``Bd``, ``Cd``, ``Dd``, ``dt``);
     ``force_commanded_vs_applied.png``, ``mu_bounds_constrained.png``,
@@ -322,7 +423,9 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     The µ design with hard force and stroke bounds (``mu_constrained``,
     :func:`~lmi_suspension.seat.constrained.design_constrained_mu`) takes minutes, so the
     shipped one is loaded and re-certified here (µ bounds, worst-case force and stroke,
-    poles), and simulated like the others, also as its 1 kHz sampled-data loop.
+    poles), and simulated like the others, also as its 1 kHz sampled-data loop; so are the
+    refined controller (``mu_refined``) and the controller for every occupant
+    (``mu_occupants``, a search of about 15 minutes).
 
     Parameters
     ----------
@@ -446,6 +549,10 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     refined = shipped(
         "mu_refined", "µ controller refined to the force/stroke/pole bounds (shipped, "
         "re-certified) ...", api.load_refined, lambda c: "", design=api.DEFAULT_DESIGN)
+    occupants = shipped(
+        "mu_occupants", "seat controller for every occupant, spring and delay of the set "
+        "(shipped, re-certified) ...", api.load_occupants, lambda c: "",
+        design=api.DEFAULT_DESIGN)
 
     # --- comparison controllers ------------------------------------------------------
     controllers: dict[str, object] = {"passive": None}
@@ -463,6 +570,8 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         controllers["mu_constrained"], discrete["mu_constrained"] = constrained[:2]
     if refined is not None:
         controllers["mu_refined"], discrete["mu_refined"] = refined[:2]
+    if occupants is not None:
+        controllers["mu_occupants"], discrete["mu_occupants"] = occupants[:2]
 
     # --- roads and the physical limit ------------------------------------------------
     road_bump = bump(t_end=cfg.bump_t_end, dt=cfg.road_dt)
@@ -580,11 +689,21 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         "musyn_options": _jsonable(musyn_opts),
         "version": __version__,
     }
-    files.append(save_controller(out / "controller.json", mu_design.K, inputs=["x1", "x3"],
-                                 outputs=["u"], metadata=metadata))
+    # controller.json is the controller for every occupant; the µ design only where that
+    # one could not be loaded (a fact of the summary then says so)
+    exported = EXPORTED if occupants is not None else "mu"
+    if exported == "mu":
+        K_export, meta_export = mu_design.K, dict(metadata)
+    else:
+        K_export, meta_export = occupants[0], dict(occupants[2])
+        meta_export["certified_here"] = {"mu_peak_upper": occupants[3].mu_peak,
+                                         "mu_peak_lower": occupants[3].mu_lower_peak}
+    meta_export.update(exported_as=exported, version=__version__)
+    files.append(save_controller(out / "controller.json", K_export, inputs=["x1", "x3"],
+                                 outputs=["u"], metadata=_jsonable(meta_export)))
     # the same controller for MATLAB / Simulink (lmi-suspension export does it for any file)
-    files.append(save_controller_mat(out / "controller.mat", mu_design.K, inputs=["x1", "x3"],
-                                     outputs=["u"], metadata=metadata))
+    files.append(save_controller_mat(out / "controller.mat", K_export, inputs=["x1", "x3"],
+                                     outputs=["u"], metadata=_jsonable(meta_export)))
     # every designed controller, with its 1 kHz Tustin realization (the constrained one's
     # own; a controller with poles above the Nyquist rate is discretised all the same:
     # that is a fact about the design, which the summary's facts and the table report,
@@ -595,7 +714,8 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
             continue
         Kd = discrete.get(name) or discretise_controller(K, _SAMPLE_TIME,
                                                          warn_unresolved=False)
-        shipped = {"mu_constrained": constrained, "mu_refined": refined}.get(name)
+        shipped = {"mu_constrained": constrained, "mu_refined": refined,
+                   "mu_occupants": occupants}.get(name)
         meta = dict(metadata) if name == "mu" else (
             dict(shipped[2]) if shipped is not None else
             {"description": f"{_LONG_NAMES[name]}: y = [x1, x3] (m) -> u (N)"})
@@ -604,14 +724,31 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                                      inputs=["x1", "x3"], outputs=["u"], metadata=meta,
                                      discrete=Kd))
     tok = stage("monte_carlo", f"Monte-Carlo over the uncertainty set ({cfg.mc_n} samples, "
-                f"µ controller, {cfg.mc_workers or 'no'} Dask workers) ...")
+                f"{_LONG_NAMES[exported]}, {cfg.mc_workers or 'no'} Dask workers) ...")
     mc_data = _monte_carlo(out / "controller.json", cfg, (delays[0], delays[-1]), params,
                            int(rng_mc.integers(2**63)), limit.peak, road_bump)
     files.append(out / "monte_carlo")  # results.parquet, tradeoff.png, spec.json, parts/
     done(tok)
     worst = mc_data["worst"]
     say(f"  worst sample: peak |z3''| {worst['peak_z3dd']:.3f} m/s² "
-        f"(stable {worst['stable']})")
+        f"(stable {worst['stable']}; {mc_data['worst_ratio_to_own_limit']:.2f} × its own "
+        "limit)")
+    n_map = len(cfg.map_m3) * len(cfg.map_k1_rel) * len(cfg.map_delays)
+    tok = stage("occupant_map", f"occupant mass × seat spring map ({n_map} cells, "
+                f"{_LONG_NAMES[exported]}, each seat's own limit) ...")
+    map_data, map_table, map_spec, map_worst = _occupant_map(
+        out / "controller.json", cfg, params, int(rng_mc.integers(2**63)))
+    files.append(out / "occupant_map")
+    worst_run = None
+    if map_worst is not None:
+        worst_seat = dataclasses.replace(params, m3=map_worst["m3"], k1=map_worst["k1"])
+        # the map's step, so that the figure's peaks are the map's
+        worst_run = simulate(K_export, road_bump, delay=map_worst["delay"], params=worst_seat,
+                             dt=cfg.map_step)
+    done(tok)
+    say(f"  {map_data['unstable_cells_in_set']} unstable cells in the set, "
+        f"{map_data['unstable_cells']} in the map; worst in the set: "
+        + _map_worst_text(map_data["worst_in_set"]))
 
     # --- figures ---------------------------------------------------------------------
     tok = stage("figures", "writing figures ...")
@@ -688,6 +825,25 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
             label="refined designs (shipped)", bound_label="force bound of the refinement",
             title="Bump peak against the force bound (refined µ designs)"),
             "tradeoff_refined.png")
+    map_fig = _plot_occupant_map(map_table, map_spec, out / "controller.json", map_data,
+                                 _LONG_NAMES[exported])
+    if map_fig is not None:
+        save(map_fig, "occupant_map.png")
+        import matplotlib.pyplot as plt
+
+        plt.close(map_fig)  # the sweep's plot is a pyplot figure
+    if worst_run is not None:
+        fig = figures.plot_bounded_response(
+            worst_run, u_max=u_max, z_max=z_max,
+            title=f"{_LONG_NAMES[exported]}, the map's worst seat in the set:\n"
+                  + _map_worst_text(map_data["worst_in_set"]))
+        own = map_data["worst_in_set"]["limit_peak"]
+        if own is not None and math.isfinite(own):
+            for sign in (1, -1):  # the seat's own limit: what the ratio is measured against
+                fig.axes[0].axhline(sign * own, color="tab:blue", ls=":",
+                                    label="this seat's limit (LP)" if sign > 0 else None)
+            fig.axes[0].legend(fontsize=8, loc="upper right")
+        save(fig, "worst_case.png")
     done(tok)
 
     # --- summary.json ---------------------------------------------------------------
@@ -697,6 +853,9 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     total = time.perf_counter() - t_start
     timings["total"] = total
     facts = _design_facts(summaries, params.u_max)
+    if exported != EXPORTED:
+        facts += (f"controller.json holds the {_LONG_NAMES[exported]} design: "
+                  f"{_LONG_NAMES[EXPORTED]} failed ({errors.get(EXPORTED, 'not loaded')})",)
     data = {
         "version": __version__, "quick": bool(quick), "delays": list(delays),
         "simulation_dt": dt, "units": {"z3dd": "m/s^2", "x1": "m", "u": "N", "delay": "s",
@@ -722,6 +881,10 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
             "check": constrained[3], "design": constrained[2]},
         "mu_refined": None if refined is None else {
             "check": refined[3], "design": refined[2]},
+        "mu_occupants": None if occupants is None else {
+            "check": occupants[3], "design": occupants[2]},
+        "exported": exported,
+        "occupant_map": map_data,
         "timings": timings,
         "facts": list(facts),
     }
@@ -734,6 +897,43 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                             limit_peak=float(limit.peak), mu_peak=float(mu_design.mu_peak),
                             mu_lower_peak=float(mu_design.mu_lower_peak), seconds=total,
                             timings=dict(timings), data=data, facts=facts)
+
+
+def _map_worst_text(worst: Mapping | None) -> str:
+    """The occupant map's worst cell in the set, in one phrase."""
+    if worst is None:
+        return "no cell"
+    where = (f"m3 {worst['m3']:.0f} kg, k1 {worst['k1']:.0f} N/m, "
+             f"{worst['delay'] * 1e3:g} ms")
+    if worst["error"] is not None or not (worst["stable"] and worst["stable_sim"]):
+        return f"unstable at {where}"
+    return (f"{worst['limit_ratio']:.2f} × its own limit at {where} "
+            f"(|u| {worst['peak_u']:.0f} N, |x1| {worst['peak_x1']:.3f} m)")
+
+
+def _plot_occupant_map(table, spec, controller: Path, entry: Mapping, name: str):
+    """The sweep's map of the occupant grid (:func:`~lmi_suspension.sweep.plots.plot_map`)
+    with the set's box and its worst cell drawn."""
+    from matplotlib.patches import Rectangle
+
+    from ..sweep.plots import plot_map
+
+    fig = plot_map(table, spec, str(controller))
+    if fig is None:
+        return None
+    ax = fig.axes[0]
+    (m_lo, m_hi), (k_lo, k_hi) = entry["set"]["m3"], entry["set"]["k1"]
+    ax.add_patch(Rectangle((m_lo, k_lo), m_hi - m_lo, k_hi - k_lo, fill=False, ec="white",
+                           ls="--", lw=1.5, label=f"the set ({m_lo:g}-{m_hi:g} kg, {k_lo:.0f}-{k_hi:.0f} N/m)"))
+    worst = entry["worst_in_set"]
+    if worst is not None:
+        ax.plot(worst["m3"], worst["k1"], "o", ms=14, mfc="none", mec="r",
+                label="worst in the set")
+    ax.legend(loc="upper left", fontsize=8)
+    ax.set_title(f"{name}: worst peak |z3''| / own limit over delays "
+                 f"{', '.join(format(d * 1e3, 'g') for d in spec.grid[2][1])} ms",
+                 fontsize=10)
+    return fig
 
 
 def _design_facts(summaries, u_max: float) -> tuple:
@@ -823,6 +1023,15 @@ def comparison_table(summary: ReproduceSummary) -> str:
                      f"{stable:>7}")
     lines.append(f"physical limit (LP, full road knowledge): {summary.limit_peak:.3f} m/s²; "
                  f"µ peak upper {summary.mu_peak:.4f}, lower {summary.mu_lower_peak:.4f}")
+    grid = summary.data.get("occupant_map")
+    if grid:
+        exported = _LONG_NAMES.get(summary.data.get("exported"), "?")
+        lines.append(textwrap.fill(
+            f"controller.json ({exported}) over occupant mass × seat spring "
+            f"({grid['cells']} cells, each seat's own limit): "
+            f"{grid['unstable_cells_in_set']} unstable in the set, {grid['unstable_cells']} "
+            f"in the map; worst in the set {_map_worst_text(grid['worst_in_set'])}",
+            width=len(head)))
     # one screen: the facts wrapped to the table's width
     lines += [textwrap.fill(fact, width=len(head), initial_indent="- ",
                             subsequent_indent="  ") for fact in summary.facts]

@@ -12,7 +12,7 @@ from .spec import SweepSpec
 __all__ = ["plot_map", "plot_tradeoff", "write_figures"]
 
 _LABELS = {"m3": "upper-body mass m3 [kg]", "delay": "actuator delay [ms]",
-           "speed_kmh": "speed [km/h]", "height": "bump height [m]", "length": "bump length [m]",
+           "speed_kmh": "speed [km/h]", "k1": "seat spring k1 [N/m]", "height": "bump height [m]", "length": "bump length [m]",
            "limit_ratio": "peak |z3''| / physical limit", "peak_z3dd": "peak |z3''| [m/s²]",
            "wrms_z3dd": "Wk-weighted RMS z3'' [m/s²]", "peak_x1": "peak |x1| [m]"}
 #: axes shown in milliseconds
