@@ -376,6 +376,63 @@ def test_scalar_real_block(m, expected):
     assert res.upper == pytest.approx(expected, abs=1e-6)
 
 
+def _seat_matrix(name):
+    """A matrix of the seat's mixed-µ loop and its structure (tests/data: where it came
+    from is written in the file)."""
+    import json
+    from pathlib import Path
+
+    data = json.loads((Path(__file__).parent / "data" / "seat_mixed_mu_matrices.json")
+                      .read_text())
+    m = data["matrices"][name]
+    return np.array(m["re"]) + 1j * np.array(m["im"]), data["blk"]
+
+
+@pytest.mark.slow
+def test_lmi_bound_resolves_scalings_that_span_many_decades():
+    """On this matrix of the seat's loop the scalings that certify a bound near µ span
+    more than 13 decades.  The margin problem alone stalled at 1.20 (its margin is
+    measured against X_R ⪯ I, so those scalings' margin is below the solver's
+    tolerance), and SLICOT's AB13MD stops at 0.901 (computed here).  Passes in the
+    frame of the previous scalings reach 0.408 (measured 2026-11-28, Haswell) against
+    a lower bound of 0.400 (M[1, 1] ≈ -0.4 is real to 1e-6: a real parameter's own loop);
+    0.5 leaves room for other paths and kernels, and both 0.901 and 1.20 fail it."""
+    slycot = pytest.importorskip("slycot")
+    M, blk = _seat_matrix("b")
+    ab_bound, *_ = slycot.ab13md(M, np.ones(8, dtype=int), np.array([2] + [1] * 7))
+    assert ab_bound > 0.9
+    res = mussv(M, blk, method="lmi", rng=np.random.default_rng(0))
+    assert lmi_certified_bound(M, res) <= res.upper * (1 + 1e-9)
+    assert_lower_certified(M, res)
+    assert 0.39 < res.lower <= res.upper < 0.5
+
+
+def test_lmi_margin_problem_retries_a_failed_solve(monkeypatch):
+    """A margin problem whose solve fails at the default regularisation (injected here;
+    on the seat's matrices Clarabel's factorisation failed at its first step) is solved
+    again with more, and the bound is the one of an undisturbed run."""
+    import cvxpy as cp
+
+    rng = np.random.default_rng(21)
+    blk = [[-1, 0], [2, 0], [1, 1]]
+    M = crandn(rng, 4, 4)
+    clean = mussv(M, blk, method="lmi", rng=np.random.default_rng(0))
+    calls = []
+    solve = cp.Problem.solve
+
+    def flaky(self, *args, **kwargs):
+        calls.append(kwargs.get("static_regularization_constant"))
+        if calls[-1] is None:
+            raise cp.error.SolverError("injected: factorisation failed")
+        return solve(self, *args, **kwargs)
+
+    monkeypatch.setattr(cp.Problem, "solve", flaky)
+    res = mussv(M, blk, method="lmi", rng=np.random.default_rng(0))
+    assert None in calls and 1e-7 in calls
+    assert lmi_certified_bound(M, res) <= res.upper * (1 + 1e-9)
+    assert res.upper == pytest.approx(clean.upper, rel=1e-5)
+
+
 def test_mixed_bounds_ordered_and_certified():
     rng = np.random.default_rng(21)
     blk = [[-1, 0], [2, 0], [1, 1]]

@@ -62,6 +62,22 @@ __all__ = ["MussvOptions", "MussvResult", "MussvTimings", "mussv"]
 logger = logging.getLogger(__name__)
 
 _METHODS = ("auto", "fast", "lmi", "ab13md")
+#: Clarabel's static regularisation on the retries of a failed D-G margin problem.  On
+#: four matrices of the seat's mixed-µ loop (‖M‖ = 35; tests/data/
+#: seat_mixed_mu_matrices.json holds two) every solve at the default 1e-8 ended in
+#: NumericalError at its first step, and the LMI route returned its starting value
+#: (1.19, where the bound is 0.41-0.46); 1e-7 solved most, 1e-6 the rest (measured
+#: 2026-11-28).
+#: Each solution is certified by :func:`_certify` whatever the solver's settings.
+_LMI_RECOVERY_REG = (1e-7, 1e-6, 1e-5)
+#: passes of the LMI iteration, each in the frame of the previous pass's scalings
+#: (:func:`_lmi_upper`).  The margin problem measures its margin against ``X_R ⪯ I``, so
+#: scalings whose entries span 1e-13 give margins below the solver's tolerance: the
+#: iteration stalls there, at 1.20-1.22 on those matrices, where AB13MD certified
+#: 0.55-1.09.  Reframed, the found scalings are the identity and the next pass resolves
+#: the next decades: 0.41-0.46 after 3-5 passes, against lower bounds of 0.4 (the
+#: same matrices).  A pass runs only while the gap to the lower bound is open.
+_LMI_PASSES = 6
 #: AB13MD's value is taken where the numpy check of its scalings confirms it to this
 #: relative margin (they agreed to 1e-9 on the seat's occupant structure)
 _AB13MD_CONFIRM = 1e-6
@@ -500,15 +516,24 @@ class _LmiBound:
         Ms = M / scale
         self.Me.value = np.block([[Ms.real, -Ms.imag], [Ms.imag, Ms.real]])
         self.beta2.value = 1.0
-        try:
-            with warnings.catch_warnings():
-                # "Solution may be inaccurate": every solution is re-certified below.
-                warnings.simplefilter("ignore", UserWarning)
-                self.problem.solve(solver=self.opts.solver, **self._solver_kwargs())
-        except cp.error.SolverError as exc:
-            logger.debug("LMI solve failed at beta=%g: %s", beta, exc)
-            return np.inf, None
-        if self.problem.status not in ("optimal", "optimal_inaccurate") or self.p.value is None:
+        kwargs = self._solver_kwargs()
+        retries = _LMI_RECOVERY_REG if self.opts.solver.upper() == "CLARABEL" else ()
+        for reg in (None, *retries):
+            if reg is not None:
+                kwargs = dict(kwargs, static_regularization_constant=reg)
+            try:
+                with warnings.catch_warnings():
+                    # "Solution may be inaccurate": every solution is re-certified below.
+                    warnings.simplefilter("ignore", UserWarning)
+                    self.problem.solve(solver=self.opts.solver, **kwargs)
+            except cp.error.SolverError as exc:
+                logger.debug("LMI solve failed at beta=%g (regularisation %s): %s", beta,
+                             reg, exc)
+                continue
+            if self.problem.status in ("optimal", "optimal_inaccurate") \
+                    and self.p.value is not None:
+                break
+        else:
             return np.inf, None
         XL, XR, G = self.scalings()
         # The problem saw M/β with β² = 1: its G multiplies M/β, so G(M) = β G(M/β).
@@ -607,6 +632,61 @@ def _ab13md_upper(M, blocks, call, logd0):
 
 
 def _lmi_upper(M, lmi: _LmiBound, hi, scal_hi, lo, opts: MussvOptions):
+    """The D-G bound by passes of :func:`_lmi_pass`, each in the frame of the scalings
+    the previous pass found; returns (bound, scalings, solves).
+
+    A frame ``(D_L, D_R)`` (square roots of the found ``X_L``, ``X_R``, normalised) turns
+    ``M`` into ``D_L M D_R⁻¹``; scalings ``(X_L', X_R', G')`` of that matrix are
+    ``(D_L X_L' D_L, D_R X_R' D_R, D_R G' D_L)`` of ``M`` (they commute with the
+    structure), and are certified on ``M`` itself.  The first pass is in the
+    identity frame; another follows while the last one made progress and the gap to
+    the lower bound ``lo`` is open, at most :data:`_LMI_PASSES` in all
+    (:data:`_LMI_PASSES` says why).
+    """
+    n_out, n_in = M.shape
+    best, best_scal, solves = _lmi_pass(M, lmi, hi, scal_hi, lo, opts)
+    for _ in range(_LMI_PASSES - 1):
+        if best_scal is None or (lo > 0 and best <= lo * (1 + 1e3 * opts.rtol)) \
+                or best <= 1e-9 * max(hi, np.finfo(float).tiny):
+            break
+        XL, XR, _G = best_scal
+        scale = float(np.max(np.real(np.diag(XR))))
+        if not (np.isfinite(scale) and scale > 0):
+            break
+        DL = _blockwise_root(XL / scale, lmi.struct.row_slices())
+        DR = _blockwise_root(XR / scale, lmi.struct.col_slices())
+        try:
+            DRi = np.linalg.inv(DR)
+        except np.linalg.LinAlgError:
+            break
+        if not np.all(np.isfinite(DRi)):
+            break
+        bf, scal_f, k = _lmi_pass(DL @ M @ DRi, lmi, best,
+                                  (np.eye(n_out), np.eye(n_in), None), lo, opts)
+        solves += k
+        if scal_f is None:
+            break
+        XLf, XRf, Gf = scal_f
+        if Gf is None:
+            Gf = np.zeros((n_in, n_out))
+        scal = (DL @ XLf @ DL, DR @ XRf @ DR, DR @ Gf @ DL)
+        bc = _certify(M, *scal)
+        if not bc < best * (1 - opts.rtol):
+            break
+        best, best_scal = bc, scal
+    return best, best_scal, solves
+
+
+def _blockwise_root(X, slices):
+    """The square root of a block-diagonal scaling, block by block: after a few passes
+    its blocks span more decades than one eigendecomposition of the whole resolves."""
+    R = np.zeros_like(X)
+    for sl in slices:
+        R[sl, sl] = _sqrtm_psd(X[sl, sl])
+    return R
+
+
+def _lmi_pass(M, lmi: _LmiBound, hi, scal_hi, lo, opts: MussvOptions):
     """Exact D-G bound by a sequence of margin problems; returns (bound, scalings, solves).
 
     At a tested ``β = t`` the largest margin ``s`` is positive iff the D-G bound is
