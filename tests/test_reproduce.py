@@ -19,6 +19,7 @@ from lmi_suspension.io import load_controller
 from lmi_suspension.mu.dk import MusynIteration
 from lmi_suspension.seat.constrained import ConstrainedCheck
 from lmi_suspension.seat.design import MuCheck, SeatMuDesign
+from lmi_suspension.seat.multimodel import SHIPPED_OCCUPANTS
 from lmi_suspension.seat.sampled import discretise_controller, simulate_sampled
 from lmi_suspension.sweep import read_results
 from lmi_suspension.seat import (
@@ -45,8 +46,10 @@ K_CONSTRAINED = control.ss([[-150.0]], [[150.0, 0.0]], [[4000.0]], [[0.0, 500.0]
 FAST_POLE = 5000.0
 #: the stand-in of the shipped refined controller: another low-passed stiffness
 K_REFINED = control.ss([[-250.0]], [[250.0, 0.0]], [[6000.0]], [[0.0, 800.0]])
-#: the stand-in of the shipped controller for every occupant (the one exported)
-K_OCCUPANTS = control.ss([[-180.0]], [[180.0, 0.0]], [[9000.0]], [[0.0, 1200.0]])
+#: the shipped controller for every occupant itself (the one exported; fast enough to
+#: load and simulate, and unstable at the quick map's k1 -50 % cells, so that the map's
+#: instability path runs)
+K_OCCUPANTS = load_controller(SHIPPED_OCCUPANTS)[0]
 
 
 def _stand_in(fail_riccati=False, fail_occupants=False):
@@ -99,7 +102,8 @@ def _stand_in(fail_riccati=False, fail_occupants=False):
         if fail_occupants:
             raise OSError("stand-in: mu_occupants.json missing")
         Kd = discretise_controller(K_OCCUPANTS, 1e-3)
-        return K_OCCUPANTS, Kd, {"description": "stand-in occupants", "u_bound": 1500.0}
+        return K_OCCUPANTS, Kd, {"description": "stand-in occupants", "u_bound": 1500.0,
+                                 "discretisation": "Tustin, dt = 0.001 s"}
 
     def load_refined_tradeoff():
         calls.append("tradeoff")
@@ -218,8 +222,10 @@ def test_controller_json_is_the_controller_for_every_occupant(run):
     assert list(K.input_labels) == ["x1", "x3"] and list(K.output_labels) == ["u"]
     assert meta["exported_as"] == "mu_occupants" and meta["version"]
     assert meta["description"] == "stand-in occupants"
-    # re-certified in this run (the stand-in certificate's µ)
-    assert meta["certified_here"] == {"mu_peak_upper": 1.2, "mu_peak_lower": 1.1}
+    # what this run recomputed (the stand-in certificate's µ), and no claim of a
+    # discretisation this file does not hold
+    assert meta["paper_mu_nominal_seat"] == {"upper": 1.2, "lower": 1.1}
+    assert "discretisation" not in meta
     data = json.loads((run.out / "summary.json").read_text())
     assert data["exported"] == "mu_occupants"
     # the Monte-Carlo ran on it: one of its rows recomputed with K_OCCUPANTS
@@ -277,7 +283,9 @@ def test_occupant_map_is_what_direct_computations_give(run):
         sorted(p0.k1 * (1 + x) for x in cfg.map_k1_rel), rel=1e-12)
     unstable = [not closed_loop_stable(K_OCCUPANTS, r["delay"],
                                        SeatParameters(m3=r["m3"], k1=r["k1"])) for r in rows]
-    assert grid["unstable_cells"] == sum(unstable)
+    # the k1 -50 % cells (outside the set) are unstable, the others are not
+    assert grid["unstable_cells"] == sum(unstable) == 2 and grid["failed_cells"] == 0
+    assert grid["unstable_cells_in_set"] == 0
     inside = [r for r in rows if 30.0 <= r["m3"] <= 70.0
               and 0.8 * p0.k1 * (1 - 1e-12) <= r["k1"] <= 1.2 * p0.k1 * (1 + 1e-12)]
     # the quick grid's set cells: m3 30 and 70 at k1 nominal and +20 %
@@ -289,6 +297,8 @@ def test_occupant_map_is_what_direct_computations_give(run):
     own = bump_limit(road, seat, dt=2e-3).certified_peak
     direct = simulate(K_OCCUPANTS, road, delay=w["delay"], params=seat, dt=cfg.map_step)
     assert w["limit_ratio"] == pytest.approx(np.max(np.abs(direct.z3dd)) / own, rel=1e-9)
+    # the figure's run is the worst cell replayed: the same seat, delay, road and peak
+    assert w["replayed_peak_z3dd"] == pytest.approx(w["peak_z3dd"], rel=1e-12)
     table = R.comparison_table(run.summary)
     assert "controller.json (µ, every occupant)" in table
     assert f"{w['limit_ratio']:.2f} × its own limit" in table
@@ -326,6 +336,19 @@ def test_occupant_map_finds_the_shipped_controllers_stability_boundary(
     else:
         assert entry["unstable_cells_in_set"] == 1 and worst["k1"] == soft.k1
         assert R._map_worst_text(entry["worst_in_set"]).startswith("unstable at m3 30 kg")
+
+
+def test_map_worst_text_names_an_unstable_seat_and_an_empty_set():
+    row = {"m3": 30.0, "k1": 15500.0, "delay": 0.025, "stable": False, "stable_sim": False,
+           "limit_ratio": None, "peak_u": None, "peak_x1": None, "error": None}
+    assert R._map_worst_text(row) == "unstable at m3 30 kg, k1 15500 N/m, 25 ms"
+    diverged = dict(row, stable=True)  # linear loop stable, the saturating run diverged
+    assert R._map_worst_text(diverged).startswith("unstable at")
+    ok = dict(row, stable=True, stable_sim=True, limit_ratio=2.5, peak_u=1400.0,
+              peak_x1=0.05)
+    assert R._map_worst_text(ok) == ("2.50 × its own limit at m3 30 kg, k1 15500 N/m, 25 ms "
+                                    "(|u| 1400 N, |x1| 0.050 m)")
+    assert R._map_worst_text(None).startswith("none")
 
 
 @pytest.mark.slow

@@ -83,8 +83,8 @@ class _Settings:
     mc_n: int
     #: Dask workers of the Monte-Carlo sweep and of the occupant map (0: in this process)
     mc_workers: int
-    #: the occupant map's grid: m3 (kg), k1 relative to Table 1, delays (s), and its
-    #: simulation step (s)
+    #: the occupant map's grid: m3 (kg), k1 relative to Table 1, delays (s); its
+    #: simulation step (s) and record length (s)
     map_m3: tuple
     map_k1_rel: tuple
     map_delays: tuple
@@ -137,24 +137,33 @@ def _monte_carlo(controller: Path, cfg: _Settings, delay_range, params, seed: in
         shutil.rmtree(out)  # a new controller: the previous run's cases are not this one's
     res = run_sweep(spec, out, workers=cfg.mc_workers)
     rows = read_results(out)[0].to_pylist()
-    score = [r["peak_z3dd"] if r["stable"] and r["stable_sim"] else math.inf for r in rows]
-    worst = rows[int(np.argmax(score))]
+    # an unstable sample is the worst; one that raised has no figures and never is
+    score = [-math.inf if r["error"] is not None else
+             r["peak_z3dd"] if r["stable"] and r["stable_sim"] else math.inf for r in rows]
+    k_worst = int(np.argmax(score))
+    worst = rows[k_worst]
+    peak = math.nan if worst["peak_z3dd"] is None else worst["peak_z3dd"]
     own = math.nan
-    if math.isfinite(score[int(np.argmax(score))]):
-        # the worst sample against its own limit too (one LP: the seat differs from the
-        # nominal one whose limit the samples are divided by)
+    if math.isfinite(score[k_worst]):
+        # the sample with the largest peak against its own limit too (one LP: its seat is
+        # not the nominal one the samples are divided by); the certified peak, as the
+        # occupant map and certify_occupants take it
         from ..seat import bump_limit
 
         seat = dataclasses.replace(params, **{k: worst[k] for k in ("m3", "k1", "k2", "k3")})
-        own = bump_limit(road, seat, dt=cfg.limit_dt).certified_peak
+        try:
+            own = bump_limit(road, seat, dt=cfg.limit_dt).certified_peak
+        except LmiSuspensionError as exc:
+            logger.info("Monte-Carlo: no limit for its worst sample (%s)", exc)
     return {
         "n": cfg.mc_n, "m3_range": list(_MC_M3), "stiffness_rel": _MC_STIFFNESS_REL,
         "delay_range": [float(d) for d in delay_range], "seed": seed,
         "peak_z3dd": [r["peak_z3dd"] for r in rows],
         "delays": [r.get("delay", float(delay_range[0])) for r in rows],
         "worst": {k: v for k, v in worst.items() if k not in ("controller", "seconds")},
-        "worst_ratio_to_limit": worst["peak_z3dd"] / nominal_limit,
-        "worst_own_limit": own, "worst_ratio_to_own_limit": worst["peak_z3dd"] / own,
+        "worst_ratio_to_limit": peak / nominal_limit,
+        # of the sample with the largest peak (not the largest ratio over the samples)
+        "worst_own_limit": own, "worst_ratio_to_own_limit": peak / own,
         # (its wall time is the stage's, in "timings")
         "sweep": {"workers": res.workers, "failed": res.n_failed,
                   "table": "monte_carlo/results.parquet"},
@@ -168,7 +177,9 @@ def _occupant_map(controller: Path, cfg: _Settings, params, seed: int) -> tuple:
     :func:`~lmi_suspension.seat.bump_limit` for that seat) and its exact-delay stability.
     The table goes to ``occupant_map/``.  Returns ``(entry, table, spec, worst)``: the
     summary's ``occupant_map`` entry, the sweep's table and spec, and the worst row inside
-    the set (the unstable one if any, else the largest ratio)."""
+    the set: the first unstable one in case order if any, else the one of the largest
+    ratio (cases that raised, and cells whose limit LP failed, are counted apart, never
+    the worst)."""
     from ..seat.occupants import OccupantSet
     from ..sweep import SweepSpec, read_results, run_sweep
 
@@ -190,12 +201,19 @@ def _occupant_map(controller: Path, cfg: _Settings, params, seed: int) -> tuple:
         return all(lo * (1 - 1e-9) <= r[n] <= hi * (1 + 1e-9)
                    for n, (lo, hi) in ranges.items() if n in ("m3", "k1"))
 
-    def failed(r):
-        return r["error"] is not None or not (r["stable"] and r["stable_sim"])
+    def failed(r):  # the case raised: no figures, neither stable nor unstable
+        return r["error"] is not None
+
+    def unstable(r):  # by the Nyquist count, or diverged in the (saturating) simulation
+        return not failed(r) and not (r["stable"] and r["stable_sim"])
+
+    def has_ratio(r):  # its limit LP may have failed (nan)
+        return r["limit_ratio"] is not None and math.isfinite(r["limit_ratio"])
 
     in_set = [r for r in rows if inside(r)]
-    unstable_in = [r for r in in_set if failed(r)]
-    scored = [r for r in in_set if not failed(r) and math.isfinite(r["limit_ratio"] or math.nan)]
+    unstable_in = [r for r in in_set if unstable(r)]
+    scored = [r for r in in_set if not failed(r) and not unstable(r) and has_ratio(r)]
+    # an unstable seat of the set is its worst (the first in case order); else the ratio
     worst = unstable_in[0] if unstable_in else (
         max(scored, key=lambda r: r["limit_ratio"]) if scored else None)
     keep = ("m3", "k1", "delay", "stable", "stable_sim", "peak_z3dd", "limit_peak",
@@ -204,8 +222,11 @@ def _occupant_map(controller: Path, cfg: _Settings, params, seed: int) -> tuple:
         "grid": {"m3": list(cfg.map_m3), "k1": list(k1_values), "delay": list(cfg.map_delays)},
         "set": {"m3": list(ranges["m3"]), "k1": list(ranges["k1"])},
         "step": cfg.map_step, "cells": len(rows),
-        "unstable_cells": sum(failed(r) for r in rows),
+        "unstable_cells": sum(unstable(r) for r in rows),
         "unstable_cells_in_set": len(unstable_in),
+        "failed_cells": sum(failed(r) for r in rows),
+        "cells_in_set_without_limit": sum(not failed(r) and not unstable(r)
+                                          and not has_ratio(r) for r in in_set),
         "worst_in_set": None if worst is None else {k: worst[k] for k in keep},
         "sweep": {"workers": res.workers, "failed": res.n_failed,
                   "table": "occupant_map/results.parquet"},
@@ -399,17 +420,20 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     delay and saturation; linear stability (Nyquist, exact delay) at each delay and the
     delay margin of each controller; an ISO 8608 class-C road at 30 km/h at the smallest and
     largest delay; for the exported controller (``controller.json``), a seeded Monte-Carlo
-    over occupant mass and stiffnesses with delays drawn from ``[0, max(delays)]`` (worst
-    case reported) and the occupant map: a grid sweep of ``m3`` × ``k1`` reaching past the
-    set, each cell's worst peak over its own physical limit at the smallest and largest
-    delay and its exact-delay stability, with the worst seat in the set simulated.
+    over occupant mass and stiffnesses with delays drawn from ``[0, max(delays)]`` (the
+    sample of the largest peak reported, also against its own limit) and the occupant
+    map: a grid sweep of ``m3`` × ``k1`` reaching past the set, at the map's own delays
+    (0 and 25 ms whatever ``delays``; 25 ms with ``quick``), each cell's peak over its
+    own physical limit and its exact-delay stability, with the worst seat in the set
+    replayed for its figure.
 
     Files written: ``fig07_bump.png`` … ``fig15_mu_bounds.png`` (the paper's figures),
     ``peak_vs_delay.png``, ``iso_C_z3dd.png``, ``summary.json`` (non-finite numbers are
     written as ``null``; a ``null`` delay margin means no loss of stability below 1 s) and
     ``controller.json`` (the controller for every occupant, ``y = [x1, x3]`` in m to ``u``
-    in N, re-certified here; the µ design only where the shipped file cannot be loaded,
-    which the summary's facts then say) and ``controller.mat``;
+    in N; its µ with the paper's weights at the nominal seat recomputed here, its mixed µ
+    over the set quoted from its design; the µ design only where the shipped file cannot
+    be loaded, which the summary's facts then say) and ``controller.mat``;
     ``occupant_map.png`` (its map, the set's box and the stability boundary drawn),
     ``occupant_map/`` (the map's sweep table), ``worst_case.png`` (the worst seat of the
     map in the set, on the bump: ``z̈3`` against that seat's own limit, force, stroke);
@@ -440,8 +464,8 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     delays : sequence of float
         Actuator delays to simulate, s.
     quick : bool
-        Short records, coarser steps, at most two delays and a two-sample Monte-Carlo
-        (for tests; the figures are then rough).
+        Short records, coarser steps, at most two delays, a four-sample Monte-Carlo and a
+        six-cell occupant map (for tests; the figures are then rough).
 
     Returns
     -------
@@ -696,8 +720,12 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         K_export, meta_export = mu_design.K, dict(metadata)
     else:
         K_export, meta_export = occupants[0], dict(occupants[2])
-        meta_export["certified_here"] = {"mu_peak_upper": occupants[3].mu_peak,
-                                         "mu_peak_lower": occupants[3].mu_lower_peak}
+        # controllers/mu_occupants.json holds the 1 kHz realization; this file does not
+        meta_export.pop("discretisation", None)
+        # what this run recomputed: µ with the paper's weights at the nominal seat (the
+        # set's mixed µ is the design's own certificate, not recomputed here)
+        meta_export["paper_mu_nominal_seat"] = {"upper": occupants[3].mu_peak,
+                                                "lower": occupants[3].mu_lower_peak}
     meta_export.update(exported_as=exported, version=__version__)
     files.append(save_controller(out / "controller.json", K_export, inputs=["x1", "x3"],
                                  outputs=["u"], metadata=_jsonable(meta_export)))
@@ -714,10 +742,10 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
             continue
         Kd = discrete.get(name) or discretise_controller(K, _SAMPLE_TIME,
                                                          warn_unresolved=False)
-        shipped = {"mu_constrained": constrained, "mu_refined": refined,
-                   "mu_occupants": occupants}.get(name)
+        loaded = {"mu_constrained": constrained, "mu_refined": refined,
+                  "mu_occupants": occupants}.get(name)
         meta = dict(metadata) if name == "mu" else (
-            dict(shipped[2]) if shipped is not None else
+            dict(loaded[2]) if loaded is not None else
             {"description": f"{_LONG_NAMES[name]}: y = [x1, x3] (m) -> u (N)"})
         meta["fastest_pole"] = fastest_pole(K)
         files.append(save_controller(out / "controllers" / f"{name}.json", K,
@@ -730,9 +758,9 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     files.append(out / "monte_carlo")  # results.parquet, tradeoff.png, spec.json, parts/
     done(tok)
     worst = mc_data["worst"]
-    say(f"  worst sample: peak |z3''| {worst['peak_z3dd']:.3f} m/s² "
-        f"(stable {worst['stable']}; {mc_data['worst_ratio_to_own_limit']:.2f} × its own "
-        "limit)")
+    say(f"  worst sample: peak |z3''| {_fmt(worst['peak_z3dd'], '.3f')} m/s² "
+        f"(stable {worst['stable']}; {_fmt(mc_data['worst_ratio_to_own_limit'], '.2f')} × "
+        "its own limit)")
     n_map = len(cfg.map_m3) * len(cfg.map_k1_rel) * len(cfg.map_delays)
     tok = stage("occupant_map", f"occupant mass × seat spring map ({n_map} cells, "
                 f"{_LONG_NAMES[exported]}, each seat's own limit) ...")
@@ -742,9 +770,11 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     worst_run = None
     if map_worst is not None:
         worst_seat = dataclasses.replace(params, m3=map_worst["m3"], k1=map_worst["k1"])
-        # the map's step, so that the figure's peaks are the map's
-        worst_run = simulate(K_export, road_bump, delay=map_worst["delay"], params=worst_seat,
-                             dt=cfg.map_step)
+        # the map's road and step: the figure's run is the map's case, replayed
+        worst_run = simulate(K_export, bump(t_end=cfg.map_t_end, dt=1e-3),
+                             delay=map_worst["delay"], params=worst_seat, dt=cfg.map_step)
+        map_data["worst_in_set"]["replayed_peak_z3dd"] = float(
+            np.max(np.abs(worst_run.z3dd)))
     done(tok)
     say(f"  {map_data['unstable_cells_in_set']} unstable cells in the set, "
         f"{map_data['unstable_cells']} in the map; worst in the set: "
@@ -828,10 +858,12 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     map_fig = _plot_occupant_map(map_table, map_spec, out / "controller.json", map_data,
                                  _LONG_NAMES[exported])
     if map_fig is not None:
-        save(map_fig, "occupant_map.png")
         import matplotlib.pyplot as plt
 
-        plt.close(map_fig)  # the sweep's plot is a pyplot figure
+        try:
+            save(map_fig, "occupant_map.png")
+        finally:
+            plt.close(map_fig)  # the sweep's plot is a pyplot figure
     if worst_run is not None:
         fig = figures.plot_bounded_response(
             worst_run, u_max=u_max, z_max=z_max,
@@ -856,6 +888,11 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     if exported != EXPORTED:
         facts += (f"controller.json holds the {_LONG_NAMES[exported]} design: "
                   f"{_LONG_NAMES[EXPORTED]} failed ({errors.get(EXPORTED, 'not loaded')})",)
+    if map_data["failed_cells"] or map_data["cells_in_set_without_limit"]:
+        facts += (f"occupant map: {map_data['failed_cells']} cells raised (occupant_map/"
+                  f"results.parquet has the errors) and {map_data['cells_in_set_without_limit']}"
+                  f" stable cells of the set have no limit (LP failed): its worst case is "
+                  f"over the others",)
     data = {
         "version": __version__, "quick": bool(quick), "delays": list(delays),
         "simulation_dt": dt, "units": {"z3dd": "m/s^2", "x1": "m", "u": "N", "delay": "s",
@@ -902,10 +939,10 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
 def _map_worst_text(worst: Mapping | None) -> str:
     """The occupant map's worst cell in the set, in one phrase."""
     if worst is None:
-        return "no cell"
+        return "none: no stable cell of the set has its limit"
     where = (f"m3 {worst['m3']:.0f} kg, k1 {worst['k1']:.0f} N/m, "
              f"{worst['delay'] * 1e3:g} ms")
-    if worst["error"] is not None or not (worst["stable"] and worst["stable_sim"]):
+    if not (worst["stable"] and worst["stable_sim"]):
         return f"unstable at {where}"
     return (f"{worst['limit_ratio']:.2f} × its own limit at {where} "
             f"(|u| {worst['peak_u']:.0f} N, |x1| {worst['peak_x1']:.3f} m)")
@@ -918,21 +955,23 @@ def _plot_occupant_map(table, spec, controller: Path, entry: Mapping, name: str)
 
     from ..sweep.plots import plot_map
 
-    fig = plot_map(table, spec, str(controller))
-    if fig is None:
+    varied = [n for n, v in spec.grid if len(v) > 1][:2]
+    if varied != ["m3", "k1"]:  # plot_map's axes; the box is drawn in m3 × k1
         return None
+    fig = plot_map(table, spec, str(controller), value="limit_ratio")
     ax = fig.axes[0]
     (m_lo, m_hi), (k_lo, k_hi) = entry["set"]["m3"], entry["set"]["k1"]
     ax.add_patch(Rectangle((m_lo, k_lo), m_hi - m_lo, k_hi - k_lo, fill=False, ec="white",
-                           ls="--", lw=1.5, label=f"the set ({m_lo:g}-{m_hi:g} kg, {k_lo:.0f}-{k_hi:.0f} N/m)"))
+                           ls="--", lw=1.5,
+                           label=f"the set ({m_lo:g}-{m_hi:g} kg, {k_lo:.0f}-{k_hi:.0f} N/m)"))
     worst = entry["worst_in_set"]
     if worst is not None:
         ax.plot(worst["m3"], worst["k1"], "o", ms=14, mfc="none", mec="r",
                 label="worst in the set")
     ax.legend(loc="upper left", fontsize=8)
+    delays = dict(spec.grid).get("delay", (0.0,))
     ax.set_title(f"{name}: worst peak |z3''| / own limit over delays "
-                 f"{', '.join(format(d * 1e3, 'g') for d in spec.grid[2][1])} ms",
-                 fontsize=10)
+                 f"{', '.join(format(d * 1e3, 'g') for d in delays)} ms", fontsize=10)
     return fig
 
 

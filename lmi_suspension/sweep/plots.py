@@ -12,7 +12,8 @@ from .spec import SweepSpec
 __all__ = ["plot_map", "plot_tradeoff", "write_figures"]
 
 _LABELS = {"m3": "upper-body mass m3 [kg]", "delay": "actuator delay [ms]",
-           "speed_kmh": "speed [km/h]", "k1": "seat spring k1 [N/m]", "height": "bump height [m]", "length": "bump length [m]",
+           "k1": "seat spring k1 [N/m]", "speed_kmh": "speed [km/h]",
+           "height": "bump height [m]", "length": "bump length [m]",
            "limit_ratio": "peak |z3''| / physical limit", "peak_z3dd": "peak |z3''| [m/s²]",
            "wrms_z3dd": "Wk-weighted RMS z3'' [m/s²]", "peak_x1": "peak |x1| [m]"}
 #: axes shown in milliseconds
@@ -31,7 +32,8 @@ def _columns(table) -> dict:
 def plot_map(table, spec: SweepSpec, controller: str, value: str | None = None):
     """Heat map of ``value`` (default ``limit_ratio`` where computed, else ``peak_z3dd``)
     over the first two grid axes with more than one value, for one controller; unstable
-    cells (exact-delay Nyquist test) are hatched and the stability boundary drawn.  Other
+    cells (exact-delay Nyquist test, or a simulation that diverged) are hatched and the
+    stability boundary drawn.  Other
     axes are reduced to their worst case (largest value, unstable if any is).  Returns the
     figure, or None where the grid has fewer than two such axes."""
     import matplotlib.pyplot as plt
@@ -48,13 +50,13 @@ def plot_map(table, spec: SweepSpec, controller: str, value: str | None = None):
     stable = np.ones((len(yv), len(xv)), dtype=bool)
     pick = cols["controller"] == controller
     vals = cols[value].astype(float)
-    st = cols["stable"]
+    st, st_sim = cols["stable"], cols["stable_sim"]
     # nearest grid value: a delay is rounded to the simulation step in its case
     xi = np.abs(cols[xn].astype(float)[:, None] - np.asarray(xv)[None, :]).argmin(axis=1)
     yi = np.abs(cols[yn].astype(float)[:, None] - np.asarray(yv)[None, :]).argmin(axis=1)
     for k in np.flatnonzero(pick):
         i, j = yi[k], xi[k]
-        if st[k] is None or not st[k]:
+        if st[k] is None or not st[k] or st_sim[k] is False:
             stable[i, j] = False
         if np.isfinite(vals[k]):
             Z[i, j] = vals[k] if np.isnan(Z[i, j]) else max(Z[i, j], vals[k])
