@@ -362,3 +362,27 @@ def test_without_performance_mu_the_design_seat_asks_robust_stability_only(monke
     assert np.max(TwoBlockMu(DEFAULT_DESIGN, grid).curve(d.K)) > d.mu
     with pytest.raises(ParameterError, match="mu_performance"):
         RefineOptions(mu_performance=1)
+
+
+def test_interconnection_poles_are_the_lfts_and_refuse_a_nonzero_d22():
+    """The poles formula (D22 = 0) against the closed loop built by ``lti.lft``; with
+    D22 ≠ 0 the formula would be wrong, so it refuses."""
+    from lmi_suspension.errors import InputError
+    from lmi_suspension.seat.refine import interconnection_poles
+
+    rng = np.random.default_rng(4)
+    nw, nu, nz, ny, n, nk = 2, 1, 2, 2, 5, 3
+    D = rng.standard_normal((nz + ny, nw + nu))
+    D[nz:, nw:] = 0.0
+    P = control.ss(rng.standard_normal((n, n)) - 3 * np.eye(n),
+                   rng.standard_normal((n, nw + nu)), rng.standard_normal((nz + ny, n)), D)
+    K = control.ss(rng.standard_normal((nk, nk)) - 2 * np.eye(nk),
+                   rng.standard_normal((nk, ny)), rng.standard_normal((nu, nk)),
+                   rng.standard_normal((nu, ny)))
+    got = np.sort_complex(interconnection_poles(P, K, nw, nu, nz, ny))
+    ref = np.sort_complex(np.linalg.eigvals(np.asarray(lft(P, K, ny, nu).A)))
+    np.testing.assert_allclose(got, ref, rtol=1e-9, atol=1e-9)
+    D[nz, nw] = 0.1
+    P22 = control.ss(P.A, P.B, P.C, D)
+    with pytest.raises(InputError, match="D22"):
+        interconnection_poles(P22, K, nw, nu, nz, ny)
