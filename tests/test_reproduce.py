@@ -20,6 +20,7 @@ from lmi_suspension.mu.dk import MusynIteration
 from lmi_suspension.seat.constrained import ConstrainedCheck
 from lmi_suspension.seat.design import MuCheck, SeatMuDesign
 from lmi_suspension.seat.multimodel import SHIPPED_OCCUPANTS
+from lmi_suspension.seat.occupants import OccupantSet
 from lmi_suspension.seat.sampled import discretise_controller, simulate_sampled
 from lmi_suspension.sweep import read_results
 from lmi_suspension.seat import (
@@ -206,12 +207,22 @@ def test_summary_has_every_controller_and_delay(run):
     assert mc["worst"]["peak_z3dd"] == max(mc["peak_z3dd"]) and mc["sweep"]["failed"] == 0
     # the worst sample against its own limit: the LP of its seat, solved here
     w = mc["worst"]
-    seat = SeatParameters(m3=w["m3"], k1=w["k1"], k2=w["k2"], k3=w["k3"])
+    seat = SeatParameters(**{n: w[n] for n in ("m3", "k1", "k2", "k3", "c1", "c2", "c3")})
     own = bump_limit(bump(t_end=R._QUICK.bump_t_end, dt=R._QUICK.road_dt), seat,
                      dt=R._QUICK.limit_dt).certified_peak
     assert mc["worst_own_limit"] == pytest.approx(own, rel=1e-6)
     assert mc["worst_ratio_to_own_limit"] == pytest.approx(w["peak_z3dd"] / own, rel=1e-6)
     assert all(30.0 <= r["m3"] <= 70.0 and 0.0 <= r["delay"] <= 0.025 for r in rows)
+    # drawn over the occupant set the exported controller is designed for (the map's
+    # box): the mass, every spring and every damper, each within its range of
+    # OccupantSet, the summary naming the same ranges
+    nominal = SeatParameters()
+    for n, lo, hi in OccupantSet(nominal=nominal).ranges():
+        assert mc["ranges"][n] == [lo, hi]
+        assert all(lo <= r[n] <= hi for r in rows)
+    for n in ("k1", "c1", "c3"):  # varied, not left at the nominal seat
+        assert len({r[n] for r in rows}) == len(rows) and getattr(nominal, n) not in \
+            {r[n] for r in rows}
 
 
 @pytest.mark.slow
@@ -230,7 +241,7 @@ def test_controller_json_is_the_controller_for_every_occupant(run):
     assert data["exported"] == "mu_occupants"
     # the Monte-Carlo ran on it: one of its rows recomputed with K_OCCUPANTS
     row = read_results(run.out / "monte_carlo")[0].to_pylist()[0]
-    seat = SeatParameters(m3=row["m3"], k1=row["k1"], k2=row["k2"], k3=row["k3"])
+    seat = SeatParameters(**{n: row[n] for n in ("m3", "k1", "k2", "k3", "c1", "c2", "c3")})
     road = bump(t_end=R._QUICK.bump_t_end, dt=1e-3)
     direct = simulate(K_OCCUPANTS, road, delay=row["delay"], params=seat,
                       dt=R._QUICK.sim_dt).metrics()
@@ -297,6 +308,11 @@ def test_occupant_map_is_what_direct_computations_give(run):
     own = bump_limit(road, seat, dt=2e-3).certified_peak
     direct = simulate(K_OCCUPANTS, road, delay=w["delay"], params=seat, dt=cfg.map_step)
     assert w["limit_ratio"] == pytest.approx(np.max(np.abs(direct.z3dd)) / own, rel=1e-9)
+    # the force the controller commanded (before the delay and the clipping), and the one
+    # applied after them
+    assert w["peak_u_command"] == pytest.approx(np.max(np.abs(direct.u_command)), rel=1e-9)
+    assert w["peak_u"] == pytest.approx(np.max(np.abs(direct.u_applied)), rel=1e-9)
+    assert f"commanded |u| {w['peak_u_command']:.0f} N" in R._map_worst_text(w)
     # the figure's run is the worst cell replayed: the same seat, delay, road and peak
     assert w["replayed_peak_z3dd"] == pytest.approx(w["peak_z3dd"], rel=1e-12)
     table = R.comparison_table(run.summary)
@@ -344,10 +360,11 @@ def test_map_worst_text_names_an_unstable_seat_and_an_empty_set():
     assert R._map_worst_text(row) == "unstable at m3 30 kg, k1 15500 N/m, 25 ms"
     diverged = dict(row, stable=True)  # linear loop stable, the saturating run diverged
     assert R._map_worst_text(diverged).startswith("unstable at")
-    ok = dict(row, stable=True, stable_sim=True, limit_ratio=2.5, peak_u=1400.0,
-              peak_x1=0.05)
+    # the commanded force (the requirement's), not the clipped one the actuator applied
+    ok = dict(row, stable=True, stable_sim=True, limit_ratio=2.5, peak_u=1500.0,
+              peak_u_command=1730.0, peak_x1=0.05)
     assert R._map_worst_text(ok) == ("2.50 × its own limit at m3 30 kg, k1 15500 N/m, 25 ms "
-                                    "(|u| 1400 N, |x1| 0.050 m)")
+                                    "(commanded |u| 1730 N, |x1| 0.050 m)")
     assert R._map_worst_text(None).startswith("none")
 
 

@@ -329,8 +329,23 @@ def test_rows_are_the_simulators_numbers(reference):
         m = res.metrics()
         assert row["peak_z3dd"] == m.peak_z3dd and row["peak_x1"] == m.peak_x1
         assert row["wrms_z3dd"] == m.weighted_rms_z3dd and row["peak_u"] == m.peak_u
+        assert row["peak_u_command"] == m.peak_u_command
         assert row["stable"] == (True if K is None else closed_loop_stable(K, row["delay"], p))
         assert row["error"] is None and row["limit_ratio"] is None
+
+
+def test_rows_record_the_commanded_force_apart_from_the_applied_one(tmp_path):
+    """Ten times ``K_SIMPLE``'s gain commands about 2490 N on the bump (measured), which
+    the actuator clips at its 1500 N: the row holds both, each the simulator's."""
+    K = control.ss([[-200.0]], [[200.0, 0.0]], [[-30000.0]], [[-15000.0, 0.0]])
+    f = save_controller(tmp_path / "strong.json", K, inputs=["x1", "x3"], outputs=["u"])
+    spec = SweepSpec(controllers=(str(f),), grid=(("m3", (43.3,)),), duration=0.6,
+                     limit=False)
+    run_sweep(spec, tmp_path / "out", workers=0, figures=False)
+    row = read_results(tmp_path / "out")[0].to_pylist()[0]
+    m = simulate(K, bump(t_end=0.6), params=SeatParameters(m3=43.3), dt=SIM_STEP).metrics()
+    assert row["peak_u_command"] == m.peak_u_command > 1500.0
+    assert row["peak_u"] == m.peak_u == 1500.0
 
 
 def test_limit_ratio_is_the_peak_over_that_cases_own_limit(tmp_path, controller_file):

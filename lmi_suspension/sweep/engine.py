@@ -384,7 +384,7 @@ def _schema(spec: SweepSpec):
     fields += [("delay_used", f64), ("stable", boolean), ("stable_sim", boolean),
                ("peak_z3dd", f64), ("rms_z3dd", f64), ("wrms_z3dd", f64), ("vdv_z3dd", f64),
                ("peak_x1", f64), ("x1_within_limit", boolean), ("peak_u", f64),
-               ("saturation_time", f64), ("limit_peak", f64), ("limit_ratio", f64),
+               ("peak_u_command", f64), ("saturation_time", f64), ("limit_peak", f64), ("limit_ratio", f64),
                ("seconds", f64), ("error", pa.string())]
     return pa.schema(fields)
 
