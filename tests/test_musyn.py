@@ -678,7 +678,10 @@ def test_lmi_k_step_at_the_level_of_a_certified_controller():
     with its uncertainty channels scaled by ``(0.3 s + 1)/(s + 1)``, where the first γ
     minimisation stops at 2.47 against an optimum of 1.166: the level is recomputed
     here from SLICOT's controller and an independent closed-loop norm, and the K-step's
-    controller certifies at or below it (1.16825 against 1.16959, measured)."""
+    controller certifies at or below it (1.16825 against 1.16959, measured).  Under the
+    default K-step options that controller is the explicit formulas' (kept: status
+    "explicit"), certified the same way; a user's ``hinfsyn_options`` keep their own
+    ``controller``."""
     from lmi_suspension.mu.steps.kstep import _LEVEL_RELAX, _k_step
     from lmi_suspension.synthesis import HinfsynOptions
     from lmi_suspension.synthesis.hinfsyn import _hinfsyn
@@ -692,20 +695,25 @@ def test_lmi_k_step_at_the_level_of_a_certified_controller():
     calls = []
 
     def spy(*args, **kwargs):
-        calls.append((kwargs["method"], kwargs["options"].gamma))
+        calls.append((kwargs["method"], kwargs["options"].gamma,
+                      kwargs["options"].controller))
         return _hinfsyn(*args, **kwargs)
 
-    res = _k_step(spy, PD, nmeas, ncon, MusynOptions(), 2.0)
-    assert calls[-1] == ("lmi", pytest.approx(level, rel=1e-6))
-    assert res.method == "lmi"
-    assert any(w.startswith("LMI K-step at") for w in res.warnings)
-    CL = lft(PD, res.K, nmeas, ncon)
-    assert np.all(CL.poles().real < 0)
-    assert hinfnorm(CL)[0] <= level * (1 + 1e-6)
-    # the first K-step (no previous controller) keeps the γ minimisation
+    own = HinfsynOptions(riccati_search="bisection")  # controller="sdp", its default
+    for opts, route in ((MusynOptions(), "explicit"),
+                        (MusynOptions(hinfsyn_options=own), "sdp")):
+        res = _k_step(spy, PD, nmeas, ncon, opts, 2.0)
+        assert calls[-1] == ("lmi", pytest.approx(level, rel=1e-6), route)
+        assert res.method == "lmi" and (res.status == "explicit") == (route == "explicit")
+        assert any(w.startswith("LMI K-step at") for w in res.warnings)
+        CL = lft(PD, res.K, nmeas, ncon)
+        assert np.all(CL.poles().real < 0)
+        assert hinfnorm(CL)[0] <= level * (1 + 1e-6)
+    # the first K-step (no previous controller) keeps the γ minimisation, and the
+    # controller LMI there (at the γ optimum the explicit formulas' poles are fast)
     calls.clear()
     _k_step(spy, PD, nmeas, ncon, MusynOptions(), float("nan"))
-    assert calls == [("lmi", None)]
+    assert calls == [("lmi", None, "sdp")]
 
 
 def test_lmi_k_step_without_a_level_falls_back_and_without_a_controller_fails():

@@ -125,8 +125,9 @@ class MusynOptions:
         K-steps to µ 0.974-0.981 against 1.03 from the LMI's own.
     hinfsyn_options : HinfsynOptions or None
         Options passed to every K-step (default: ``HinfsynOptions`` with
-        ``riccati_search = "bisection"``; the Riccati K-steps also try the suboptimal
-        levels ``KSTEP_RICCATI_PROBES``).
+        ``riccati_search = "bisection"``, and the LMI K-step at a fixed level builds its
+        controller by the explicit formulas where they certify; the Riccati K-steps also
+        try the suboptimal levels ``KSTEP_RICCATI_PROBES``).
     max_dfit_order : int
         Largest order of each D-scale fit.
     dfit_rtol : float

@@ -58,6 +58,16 @@ _LEVEL_RELAX = 3e-3
 #: recovery, and where it failed (3 plants) it did so in 1.2-1.3 s instead of 4.4-4.8 s
 #: with one (measured 2026-11-26)
 _LEVEL_LED_RECOVERIES = 1
+#: how that K-step builds its controller under the default K-step options.  At a fixed
+#: level the feasibility problem's point is interior, and the explicit formulas
+#: (``HinfsynOptions(controller="explicit")``) were kept at all 5 such K-steps of a
+#: distillation run, each certified at its level, their poles at most 127-1012 rad/s (at
+#: the γ optimum of ``hinfsyn``, on the plants of ``bench_hinfsyn.py``, they are 300-8000
+#: times the plant's fastest mode, which is why ``hinfsyn`` keeps the SDP).  Default ``musyn`` on distillation, under every OpenBLAS kernel
+#: this CPU runs (Nehalem, Sandybridge, Haswell, SkylakeX) on 1 and 2 threads: the same
+#: µ per row as with the controller LMI (0.959417-0.959536), in 21.9-32.9 s instead of
+#: 26.1-44.1 s (measured 2026-11-28)
+_LEVEL_LED_CONTROLLER = "explicit"
 
 
 class HinfKStep:
@@ -315,13 +325,18 @@ def _kstep_options(opts):
             else HinfsynOptions(riccati_search="bisection"))
 
 
-def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base):
+def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base, controller: str = "sdp"):
     """The LMI K-step at a level fixed in advance: ``(1 + _LEVEL_RELAX)`` times the γ
     certified for SLICOT's controller (Riccati bisection, 0.03-0.15 s here); the
-    controller is the LMI's (feasibility, then the controller LMI, at that level),
-    certified on ``PD``.  Returns None where SLICOT finds no controller (the caller
-    then runs the γ minimisation); raises :class:`SolverError` where the LMI finds none
-    at the level within ``_LEVEL_LED_RECOVERIES`` recoveries.
+    controller is the LMI's (feasibility, then ``controller``: ``"explicit"``, the
+    explicit formulas with the controller LMI where they fail, or ``"sdp"``, the
+    controller LMI), certified on ``PD``.  Returns None where SLICOT finds no controller
+    (the caller then runs the γ minimisation); raises :class:`SolverError` where the
+    LMI finds none at the level within ``_LEVEL_LED_RECOVERIES`` recoveries.
+
+    With the default K-step options the controller is the explicit one
+    (:data:`_LEVEL_LED_CONTROLLER`): a feasibility problem's point is interior, not
+    the γ optimum's, and the explicit formulas are well conditioned there.
 
     On the D-scaled plants of the distillation problem the γ minimisation is where the
     LMI K-step loses its time and its reproducibility (9-70 s on 22 states, γ 1.0113 to
@@ -344,7 +359,7 @@ def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base):
     level = float(ric.gamma) * (1.0 + _LEVEL_RELAX)
     try:
         res = hinfsyn(PD, nmeas, ncon, method="lmi",
-                      options=replace(base, gamma=level, max_recoveries=min(
+                      options=replace(base, gamma=level, controller=controller, max_recoveries=min(
                           int(base.max_recoveries), _LEVEL_LED_RECOVERIES)),
                       feasibility_recoveries=0)
     except LmiSuspensionError as exc:
@@ -376,7 +391,9 @@ def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts,
             # 2026-11-25)
             base = replace(base, gamma_abort=hint * (1 + _KSTEP_RTOL))
         if opts.method == "lmi" and hint is not None and base.gamma is None:
-            led = _level_led_lmi(hinfsyn, PD, nmeas, ncon, base)
+            led = _level_led_lmi(hinfsyn, PD, nmeas, ncon, base,
+                                 controller=_LEVEL_LED_CONTROLLER
+                                 if opts.hinfsyn_options is None else base.controller)
             if led is not None:
                 return led
         return hinfsyn(PD, nmeas, ncon, method=opts.method, options=base, probes=probes,
