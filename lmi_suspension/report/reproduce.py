@@ -941,7 +941,7 @@ def _map_worst_text(worst: Mapping | None) -> str:
              f"{worst['delay'] * 1e3:g} ms")
     if not (worst["stable"] and worst["stable_sim"]):
         return f"unstable at {where}"
-    # the commanded force, as the requirement (|u| <= 1500 N, unclipped) reads
+    # the commanded force: the seat's force requirement (|u| <= 1500 N) is on it, unclipped
     return (f"{worst['limit_ratio']:.2f} × its own limit at {where} "
             f"(commanded |u| {worst['peak_u_command']:.0f} N, |x1| {worst['peak_x1']:.3f} m)")
 

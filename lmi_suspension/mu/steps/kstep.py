@@ -63,10 +63,11 @@ _LEVEL_LED_RECOVERIES = 1
 #: (``HinfsynOptions(controller="explicit")``) were kept at all 5 such K-steps of a
 #: distillation run, each certified at its level, their poles at most 127-1012 rad/s (at
 #: the γ optimum of ``hinfsyn``, on the plants of ``bench_hinfsyn.py``, they are 300-8000
-#: times the plant's fastest mode, which is why ``hinfsyn`` keeps the SDP).  Default ``musyn`` on distillation, under every OpenBLAS kernel
-#: this CPU runs (Nehalem, Sandybridge, Haswell, SkylakeX) on 1 and 2 threads: the same
-#: µ per row as with the controller LMI (0.959417-0.959536), in 21.9-32.9 s instead of
-#: 26.1-44.1 s (measured 2026-11-28)
+#: times the plant's fastest mode, which is why ``hinfsyn`` keeps the SDP).  Default
+#: ``musyn`` on distillation, under every OpenBLAS kernel this CPU runs (Nehalem,
+#: Sandybridge, Haswell, SkylakeX) on 1 and 2 threads: the same µ per row as with the
+#: controller LMI (0.959417-0.959536), in 21.9-32.9 s instead of 26.1-44.1 s (measured
+#: 2026-11-28, benchmarks/HISTORY.md)
 _LEVEL_LED_CONTROLLER = "explicit"
 
 
@@ -359,8 +360,9 @@ def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base, controller: str = "
     level = float(ric.gamma) * (1.0 + _LEVEL_RELAX)
     try:
         res = hinfsyn(PD, nmeas, ncon, method="lmi",
-                      options=replace(base, gamma=level, controller=controller, max_recoveries=min(
-                          int(base.max_recoveries), _LEVEL_LED_RECOVERIES)),
+                      options=replace(base, gamma=level, controller=controller,
+                                      max_recoveries=min(int(base.max_recoveries),
+                                                         _LEVEL_LED_RECOVERIES)),
                       feasibility_recoveries=0)
     except LmiSuspensionError as exc:
         raise SolverError(f"the LMI found no controller at {level:.6g}, "
