@@ -394,6 +394,20 @@ def test_another_specs_directory_is_refused(tmp_path, controller_file):
 # ----------------------------------------------------------------- resume
 
 
+def test_a_part_written_before_a_column_was_added_is_refused_on_resume(
+        tmp_path, controller_file):
+    """A directory of the same spec whose part lacks ``peak_u_command`` (as parts written
+    before that column existed do): resuming would leave the column empty for its cases;
+    it is a typed error naming the column instead."""
+    spec = _spec(controller_file, grid=(("m3", (50.0, 60.0)),))
+    run_sweep(spec, tmp_path, workers=0, figures=False)
+    part = sorted((tmp_path / "parts").glob("*.parquet"))[0]
+    pq.write_table(pq.read_table(part).drop(["peak_u_command"]), part)
+    (tmp_path / "results.parquet").unlink()
+    with pytest.raises(InputError, match="peak_u_command"):
+        run_sweep(spec, tmp_path, workers=0, figures=False)
+
+
 def test_an_interrupted_sweep_resumes_where_it_stopped(tmp_path, controller_file, reference):
     class Stop(Exception):
         pass

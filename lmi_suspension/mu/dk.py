@@ -108,8 +108,9 @@ class MusynOptions:
         once Riccati has a controller), and keeps the controller with the lowest
         certified closed-loop γ.  From the second iteration on, the LMI K-step is
         posed at a level fixed in advance, 0.3 % above the norm certified for SLICOT's
-        controller on the scaled plant (feasibility and the controller LMI only; the
-        controller is the LMI's).  Where the LMI finds none there, the K-step fails.
+        controller on the scaled plant (a feasibility problem only, then, under the
+        default ``hinfsyn_options``, the explicit controller formulas, with the
+        controller LMI where they fail their certificate or pole cap).  Where the LMI finds none there, the K-step fails.
         Where SLICOT finds none at all, it minimises γ, knowing the previous
         controller's level on the new scaled plant: the minimisation starts in the
         frame of the Riccati solutions at that level and gives up where it stops above
@@ -126,8 +127,11 @@ class MusynOptions:
     hinfsyn_options : HinfsynOptions or None
         Options passed to every K-step (default: ``HinfsynOptions`` with
         ``riccati_search = "bisection"``, and the LMI K-step at a fixed level builds its
-        controller by the explicit formulas where they certify; the Riccati K-steps also
-        try the suboptimal levels ``KSTEP_RICCATI_PROBES``).
+        controller by the explicit formulas where they pass their certificate and pole
+        cap; the Riccati K-steps also try the suboptimal levels
+        ``KSTEP_RICCATI_PROBES``).  Given options are used as they are: their
+        ``controller`` (``"sdp"`` unless set) applies to that K-step too, so pass
+        ``controller="explicit"`` to keep the faster default there.
     max_dfit_order : int
         Largest order of each D-scale fit.
     dfit_rtol : float

@@ -29,7 +29,8 @@ __all__ = ["METRIC_COLUMNS", "compute_design", "compute_limit", "design_key", "e
 #: the result columns of every row, after the case's index, controller and axis values
 METRIC_COLUMNS = ("delay_used", "stable", "stable_sim", "peak_z3dd", "rms_z3dd",
                   "wrms_z3dd", "vdv_z3dd", "peak_x1", "x1_within_limit", "peak_u",
-                  "peak_u_command", "saturation_time", "limit_peak", "limit_ratio", "seconds", "error")
+                  "peak_u_command", "saturation_time", "limit_peak", "limit_ratio",
+                  "seconds", "error")
 #: the LP step of the physical limit, s (bump_limit's default: 1500 steps over 3 s)
 _LIMIT_DT = 2e-3
 

@@ -129,10 +129,20 @@ def _load_controllers(spec: SweepSpec) -> dict:
 
 
 def _finished(out: Path) -> set:
+    """The cases already in the directory's parts.  A part without every metric column
+    (written before a column was added) is refused: resumed, its cases would keep an
+    empty column without a word."""
     import pyarrow.parquet as pq
+
+    from .case import METRIC_COLUMNS
 
     done = set()
     for part in sorted((out / _PARTS).glob("*.parquet")):
+        missing = [c for c in METRIC_COLUMNS if c not in pq.read_schema(part).names]
+        if missing:
+            raise InputError(f"{part} has no column {', '.join(missing)}: it was written by "
+                             "an earlier version of lmi_suspension; run the sweep into a "
+                             "new directory")
         done.update(pq.read_table(part, columns=["case"]).column("case").to_pylist())
     return done
 
@@ -384,8 +394,8 @@ def _schema(spec: SweepSpec):
     fields += [("delay_used", f64), ("stable", boolean), ("stable_sim", boolean),
                ("peak_z3dd", f64), ("rms_z3dd", f64), ("wrms_z3dd", f64), ("vdv_z3dd", f64),
                ("peak_x1", f64), ("x1_within_limit", boolean), ("peak_u", f64),
-               ("peak_u_command", f64), ("saturation_time", f64), ("limit_peak", f64), ("limit_ratio", f64),
-               ("seconds", f64), ("error", pa.string())]
+               ("peak_u_command", f64), ("saturation_time", f64), ("limit_peak", f64),
+               ("limit_ratio", f64), ("seconds", f64), ("error", pa.string())]
     return pa.schema(fields)
 
 

@@ -62,8 +62,10 @@ _LEVEL_LED_RECOVERIES = 1
 #: level the feasibility problem's point is interior, and the explicit formulas
 #: (``HinfsynOptions(controller="explicit")``) were kept at all 5 such K-steps of a
 #: distillation run, each certified at its level, their poles at most 127-1012 rad/s (at
-#: the γ optimum of ``hinfsyn``, on the plants of ``bench_hinfsyn.py``, they are 300-8000
-#: times the plant's fastest mode, which is why ``hinfsyn`` keeps the SDP).  Default
+#: the γ optimum of ``hinfsyn``, on the plants of ``bench_hinfsyn.py`` with n = 4-22 at
+#: its relaxation 5e-4, they were 490-7800 times the plant's fastest mode, within
+#: ``hinfsyn``'s cap but up to 5 times the controller LMI's at n = 22, which is why
+#: ``hinfsyn`` keeps the SDP; measured 2026-11-28).  Default
 #: ``musyn`` on distillation, under every OpenBLAS kernel this CPU runs (Nehalem,
 #: Sandybridge, Haswell, SkylakeX) on 1 and 2 threads: the same µ per row as with the
 #: controller LMI (0.959417-0.959536), in 21.9-32.9 s instead of 26.1-44.1 s (measured
@@ -335,8 +337,8 @@ def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base, controller: str = "
     (the caller then runs the γ minimisation); raises :class:`SolverError` where the
     LMI finds none at the level within ``_LEVEL_LED_RECOVERIES`` recoveries.
 
-    With the default K-step options the controller is the explicit one
-    (:data:`_LEVEL_LED_CONTROLLER`): a feasibility problem's point is interior, not
+    :func:`_k_step` passes ``controller=_LEVEL_LED_CONTROLLER`` (``"explicit"``) under
+    the default K-step options, the user's choice otherwise: a feasibility problem's point is interior, not
     the γ optimum's, and the explicit formulas are well conditioned there.
 
     On the D-scaled plants of the distillation problem the γ minimisation is where the
