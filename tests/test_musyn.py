@@ -446,7 +446,7 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     from lmi_suspension.mu.steps.kstep import _SEARCH_LEVELS, _best_certified
     from lmi_suspension.mu.dsearch import search_dscales
     from lmi_suspension.synthesis import HinfsynOptions
-    from lmi_suspension.synthesis.hinfsyn import riccati_level
+    from lmi_suspension.synthesis.hinfsyn import riccati_achieves, riccati_level
 
     ex = skogestad_distillation()
     w = np.logspace(-3, 3, 61)
@@ -485,6 +485,25 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     assert found.level <= found.gamma <= found.level * 1.01 * (1 + 1e-6)
     mu = mussv(freqresp(lft(ex.P, found.K), np.logspace(-4, 4, 201)), ex.blk)
     assert np.max(mu.upper) <= found.gamma * (1 + 1e-4)
+    # with one synthesis to tell whether a trial point is below the current level, the
+    # search takes the same path (same levels, same end) and bisects fewer levels;
+    # every point it did not bisect is above that level, by its level computed here
+    above = []
+
+    def achieves(PD, g):
+        ok = riccati_achieves(PD, ex.nmeas, ex.ncon, g)
+        if not ok:
+            above.append((PD, g))
+        return ok
+
+    n_full = len(calls)
+    calls.clear()
+    lean = search_dscales(*args, check=check, achieves=achieves, max_evals=60)
+    assert (lean.level, lean.level_start, lean.evaluations) == \
+        (found.level, found.level_start, found.evaluations)
+    assert above and len(calls) + len(above) == lean.evaluations == n_full
+    for PD, g in above:
+        assert riccati_level(PD, ex.nmeas, ex.ncon, bisection) > g
     # a target level ends the search at the first accepted point below it
     early = search_dscales(*args, max_evals=60, target=found.level_start * (1 - 1e-3))
     assert early.level < found.level_start * (1 - 1e-3) and early.evaluations < 60

@@ -858,7 +858,7 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
     d_blocks = np.asarray(d_blocks)
     if d_blocks.ndim != 2 or int(opts.max_dfit_order) < 1:
         return None  # per-block magnitudes expected; constant scalings requested
-    from ..synthesis.hinfsyn import riccati_level
+    from ..synthesis.hinfsyn import riccati_achieves, riccati_level
 
     # the bisection search at free γ, whatever the loop's K-steps were given
     options = replace(_kstep_options(opts), riccati_search="bisection", gamma=None)
@@ -866,6 +866,9 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
     def level(PD, bracket, rtol):
         return riccati_level(PD, nmeas, ncon, replace(options, riccati_rtol=rtol),
                              bracket=bracket)
+
+    def achieves(PD, g):
+        return riccati_achieves(PD, nmeas, ncon, g)
 
     def check(PD, g):
         return hinfsyn(PD, nmeas, ncon, method="riccati",
@@ -880,7 +883,8 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
     t0 = time.perf_counter()
     found = search_dscales(G.sys, nmeas, ncon, block_sizes(struct), omega, d_blocks,
                            0.2 + upper / np.max(upper), int(opts.max_dfit_order), level,
-                           controller, check=check, max_evals=int(opts.dscale_search),
+                           controller, check=check, achieves=achieves,
+                           max_evals=int(opts.dscale_search),
                            target=float(opts.mu_target))
     if found is None:
         logger.info("musyn: D-scale search found no controller from the first iterate")

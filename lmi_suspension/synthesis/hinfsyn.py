@@ -311,7 +311,7 @@ def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warni
         except (InfeasibleError, SolverError):
             return False
         if not certify:
-            return bool(np.all(np.real(np.linalg.eigvals(np.asarray(lft(G, K).A))) < 0))
+            return _stabilises(G, K)
         gamma = float(hinfnorm(lft(G, K))[0])
         if not np.isfinite(gamma):
             return False
@@ -349,6 +349,32 @@ def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warni
     warnings.append(f"riccati bisection: {steps} levels, lowest achieved {hi:.6g}, best "
                     f"certified {best[0]:.6g}")
     return best[1], hi
+
+
+def _stabilises(G: GeneralizedPlant, K) -> bool:
+    """Whether ``K`` stabilises the loop on ``G`` (its closed-loop poles only)."""
+    return bool(np.all(np.real(np.linalg.eigvals(np.asarray(lft(G, K).A))) < 0))
+
+
+def riccati_achieves(P, nmeas: int, ncon: int, gamma: float) -> bool:
+    """Whether SLICOT's ``sb10ad`` (job 4) returns, at ``gamma``, a controller that
+    stabilises the loop: one step of :func:`riccati_level`'s bisection, so that a level
+    is known to lie below ``gamma`` (or not) after one synthesis.
+
+    Examples
+    --------
+    >>> from lmi_suspension.examples import skogestad_distillation
+    >>> ex = skogestad_distillation()
+    >>> riccati_achieves(ex.P, 2, 2, 1.19), riccati_achieves(ex.P, 2, 2, 1.17)
+    (True, False)
+    """
+    G = _as_plant(P, nmeas, ncon)
+    check_riccati_assumptions(G)
+    try:
+        K, _ = _sb10ad(G, float(gamma))
+    except (InfeasibleError, SolverError):
+        return False
+    return _stabilises(G, K)
 
 
 def riccati_level(P, nmeas: int, ncon: int, options: HinfsynOptions | None = None, *,
