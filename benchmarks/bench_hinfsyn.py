@@ -16,7 +16,10 @@ from lmi_suspension.lti import hinfnorm, lft
 from lmi_suspension.synthesis import HinfsynOptions, hinfsyn
 from lmi_suspension.synthesis.examples import random_plant
 
-ORDERS = [4, 8, 16, 22, 30, 40]
+ORDERS = [4, 8, 16, 22, 30, 40, 60]
+#: dkpy is not run above this order: it returned no controller from 16 states on and took
+#: 343 s at 40 (run of 2026-11-27, BENCHMARKS.md history), so at 60 it would only cost time
+DKPY_MAX_ORDER = 40
 
 
 def plant(n):
@@ -40,6 +43,8 @@ def _run_dkpy(P):
 @pytest.mark.parametrize("method", ["lmi", "lmi_explicit", "riccati", "dkpy"])
 @pytest.mark.parametrize("n", ORDERS)
 def test_hinfsyn(benchmark, n, method):
+    if method == "dkpy" and n > DKPY_MAX_ORDER:
+        pytest.skip(f"dkpy is not run above {DKPY_MAX_ORDER} states (DKPY_MAX_ORDER)")
     P = plant(n)
     benchmark.extra_info.update(n=n, method=method)
 

@@ -84,10 +84,13 @@ def _seconds(bench: dict) -> float:
 def _hinfsyn_entry(benches: list[dict]) -> dict:
     by = {(b["extra_info"]["n"], b["extra_info"]["method"]): b for b in benches}
     orders = sorted({n for n, _ in by})
-    methods = [m for m in ("lmi", "riccati", "dkpy") if any(k[1] == m for k in by)]
-    label = {"lmi": "LMI", "riccati": "Riccati", "dkpy": "dkpy"}
+    methods = [m for m in ("lmi", "lmi_explicit", "riccati", "dkpy")
+               if any(k[1] == m for k in by)]
+    label = {"lmi": "LMI", "lmi_explicit": "LMI explicit", "riccati": "Riccati",
+             "dkpy": "dkpy"}
     columns = ["n"] + [f"{label[m]} [s]" for m in methods] + ["LMI/Riccati"]
     columns += [f"certified γ {label[m]}" for m in methods]
+    no_dkpy = [n for n in orders if (n, "dkpy") not in by]
     rows = []
     for n in orders:
         row: list = [n]
@@ -108,6 +111,9 @@ def _hinfsyn_entry(benches: list[dict]) -> dict:
                 cell = "inf (unstable)" if g is None or not math.isfinite(g) else f"{g:.6g}"
                 if m == "riccati" and own is not None and (g is None or not math.isfinite(g)):
                     cell += f", its own γ {own:.6g}"
+                status = b["extra_info"].get("status")
+                if m == "lmi_explicit" and status is not None and status != "explicit":
+                    cell += f" (status {status}: the controller LMI's)"
                 row.append(cell)
         rows.append(row)
     return {"id": "hinfsyn",
@@ -115,7 +121,12 @@ def _hinfsyn_entry(benches: list[dict]) -> dict:
                      (" and dkpy" if "dkpy" in methods else ""),
             "note": "one round per case (median of 1); every γ certified by "
                     "hinfnorm(lft(P, K)), inf where the loop is unstable" +
-                    ("" if "dkpy" in methods else "; dkpy not installed for this run"),
+                    ("" if "dkpy" in methods else "; dkpy not installed for this run") +
+                    ("; dkpy not run at n = " + ", ".join(str(n) for n in no_dkpy) +
+                     " (bench_hinfsyn.DKPY_MAX_ORDER)" if "dkpy" in methods and no_dkpy
+                     else "") +
+                    ("; LMI explicit: the explicit formulas' controller where its status "
+                     "says nothing else" if "lmi_explicit" in methods else ""),
             "columns": columns, "rows": rows}
 
 
@@ -213,7 +224,9 @@ def quoted_figures(entries: list[dict]) -> dict[str, str]:
             j = h["columns"].index(column)
             unstable = [str(r[0]) for r in h["rows"] if str(r[j]).startswith("inf")]
             none = [str(r[0]) for r in h["rows"] if r[j] == "no controller"]
-            f[f"hinfsyn_{method}_unstable_at"] = " and ".join(unstable) or "no"
+            f[f"hinfsyn_{method}_unstable_at"] = (
+                " and ".join([", ".join(unstable[:-1]), unstable[-1]]) if len(unstable) > 1
+                else "".join(unstable) or "no")
             f[f"hinfsyn_{method}_none_at"] = ", ".join(none) or "no"
     ratios = [r[h["columns"].index("LMI/Riccati")] for r in h["rows"] if r[0] >= 22]
     ratios = [r for r in ratios if isinstance(r, (int, float))]

@@ -441,7 +441,10 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     first point is the next D-K step; it searches SLICOT's level, every point it accepts
     is checked, and the best point's controller is certified, so its norm bounds µ of
     its loop at every frequency (checked on a dense, wider grid) and the number of
-    levels stays within the bound."""
+    levels stays within the bound.  Given ``achieves``, a trial point above the current
+    level is not bisected, and the search takes the same path: the same levels in the
+    same order, less those points, each of which the first search had found above its
+    ceiling."""
     from lmi_suspension.mu.dfit import scaled_plant
     from lmi_suspension.mu.steps.kstep import _SEARCH_LEVELS, _best_certified
     from lmi_suspension.mu.dsearch import search_dscales
@@ -456,9 +459,10 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     calls, checks = [], []
 
     def level(PD, bracket, rtol):
-        calls.append(PD.nstates)
-        return riccati_level(PD, ex.nmeas, ex.ncon, dataclasses.replace(bisection, riccati_rtol=rtol),
-                             bracket=bracket)
+        calls.append(riccati_level(PD, ex.nmeas, ex.ncon,
+                                   dataclasses.replace(bisection, riccati_rtol=rtol),
+                                   bracket=bracket))
+        return calls[-1]
 
     def check(PD, g):
         checks.append(g)
@@ -486,24 +490,32 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     mu = mussv(freqresp(lft(ex.P, found.K), np.logspace(-4, 4, 201)), ex.blk)
     assert np.max(mu.upper) <= found.gamma * (1 + 1e-4)
     # with one synthesis to tell whether a trial point is below the current level, the
-    # search takes the same path (same levels, same end) and bisects fewer levels;
-    # every point it did not bisect is above that level, by its level computed here
+    # search bisects fewer levels and takes the same path
     above = []
 
     def achieves(PD, g):
         ok = riccati_achieves(PD, ex.nmeas, ex.ncon, g)
         if not ok:
-            above.append((PD, g))
+            above.append(g)
         return ok
 
-    n_full = len(calls)
+    full, n_checks = list(calls), len(checks)
     calls.clear()
+    checks.clear()
     lean = search_dscales(*args, check=check, achieves=achieves, max_evals=60)
-    assert (lean.level, lean.level_start, lean.evaluations) == \
-        (found.level, found.level_start, found.evaluations)
-    assert above and len(calls) + len(above) == lean.evaluations == n_full
-    for PD, g in above:
-        assert riccati_level(PD, ex.nmeas, ex.ncon, bisection) > g
+    assert above and len(calls) + len(above) == lean.evaluations == found.evaluations
+    assert (lean.level, lean.level_start, lean.gamma) == (found.level, found.level_start,
+                                                          found.gamma)
+    assert len(checks) < n_checks  # nor are those points checked
+    skipped = iter(above)
+    lean_levels = iter(calls)
+    expected = next(lean_levels, None)
+    for v in full:  # the lean levels are the first search's, less the skipped points
+        if v == expected:
+            expected = next(lean_levels, None)
+        else:
+            assert v > next(skipped)  # which the first search found above the ceiling
+    assert expected is None and next(skipped, None) is None
     # a target level ends the search at the first accepted point below it
     early = search_dscales(*args, max_evals=60, target=found.level_start * (1 - 1e-3))
     assert early.level < found.level_start * (1 - 1e-3) and early.evaluations < 60
@@ -574,6 +586,44 @@ def test_riccati_level_is_where_slicot_stops_finding_a_controller():
     res = hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati",
                   options=HinfsynOptions(gamma=g * 1.003))
     assert float(hinfnorm(lft(ex.P, res.K))[0]) <= g * 1.003 * (1 + 1e-6)
+
+
+def test_riccati_level_from_a_bracket_that_holds_or_misses(monkeypatch):
+    """riccati_level from a bracket (the D-scale search's way) on the distillation
+    problem: whether the bracket holds, lies wholly above or below the level, or has it
+    at an end, the level found is where SLICOT's controllers start to stabilise the
+    loop: achieved at it and not one bisection width below (riccati_achieves, one
+    synthesis each).  A bracket that holds is bisected without testing its ends first:
+    exactly one synthesis per halving."""
+    import sys
+
+    from lmi_suspension.synthesis import HinfsynOptions
+    from lmi_suspension.synthesis.hinfsyn import riccati_achieves, riccati_level
+
+    module = sys.modules["lmi_suspension.synthesis.hinfsyn"]
+    ex = skogestad_distillation()
+    rtol = 1e-7
+    opts = HinfsynOptions(riccati_rtol=rtol)
+    g0 = riccati_level(ex.P, ex.nmeas, ex.ncon, opts)
+    calls = []
+    sb10ad = module._sb10ad
+
+    def counted(G, gamma):
+        calls.append(gamma)
+        return sb10ad(G, gamma)
+
+    monkeypatch.setattr(module, "_sb10ad", counted)
+    holds = (g0 * (1 - 1e-3), g0 * (1 + 1e-3))
+    for bracket in (holds, (g0 * 1.01, g0 * 1.02), (g0 * 0.98, g0 * 0.99),
+                    (g0 * (1 - 1e-3), g0 * (1 + 1e-9)), (g0 * (1 - 1e-9), g0 * (1 + 1e-3))):
+        calls.clear()
+        g = riccati_level(ex.P, ex.nmeas, ex.ncon, opts, bracket=bracket)
+        n = len(calls)
+        assert riccati_achieves(ex.P, ex.nmeas, ex.ncon, g)
+        assert not riccati_achieves(ex.P, ex.nmeas, ex.ncon, g / (1 + 2 * rtol))
+        assert g == pytest.approx(g0, rel=2 * rtol)
+        if bracket is holds:  # log2(2e-3 / 1e-7) = 14.3: 15 halvings and nothing else
+            assert n == int(np.ceil(np.log2(np.log(holds[1] / holds[0]) / np.log1p(rtol))))
 
 
 def test_initial_controller_takes_the_place_of_the_first_k_step():
