@@ -18,7 +18,8 @@ from lmi_suspension.synthesis.examples import random_plant
 
 ORDERS = [4, 8, 16, 22, 30, 40, 60]
 #: dkpy is not run above this order: it returned no controller from 16 states on and took
-#: 343 s at 40 (run of 2026-11-27, BENCHMARKS.md history), so at 60 it would only cost time
+#: 66-343 s at 40 (benchmarks/HISTORY.md, H∞ synthesis, 2026-11-26 and 2026-11-27), so at
+#: 60 it would only cost time
 DKPY_MAX_ORDER = 40
 
 

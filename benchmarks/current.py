@@ -125,8 +125,9 @@ def _hinfsyn_entry(benches: list[dict]) -> dict:
                     ("; dkpy not run at n = " + ", ".join(str(n) for n in no_dkpy) +
                      " (bench_hinfsyn.DKPY_MAX_ORDER)" if "dkpy" in methods and no_dkpy
                      else "") +
-                    ("; LMI explicit: the explicit formulas' controller where its status "
-                     "says nothing else" if "lmi_explicit" in methods else ""),
+                    ("; LMI explicit: HinfsynOptions(controller=\"explicit\"), the "
+                     "controller LMI's controller where the explicit formulas fail their "
+                     "check (status shown)" if "lmi_explicit" in methods else ""),
             "columns": columns, "rows": rows}
 
 
@@ -203,6 +204,12 @@ def _num(x, spec: str) -> str:
     return format(x, spec) if isinstance(x, (int, float)) else str(x)
 
 
+def _and(items: list[str]) -> str:
+    """``"a, b and c"``; ``"no"`` for none."""
+    return " and ".join([", ".join(items[:-1]), items[-1]]) if len(items) > 1 else \
+        "".join(items) or "no"
+
+
 def quoted_figures(entries: list[dict]) -> dict[str, str]:
     """Flat ``name -> text`` figures for ``docs/comparison.md`` (MyST substitutions)."""
     e = {x["id"]: x for x in entries}
@@ -224,10 +231,8 @@ def quoted_figures(entries: list[dict]) -> dict[str, str]:
             j = h["columns"].index(column)
             unstable = [str(r[0]) for r in h["rows"] if str(r[j]).startswith("inf")]
             none = [str(r[0]) for r in h["rows"] if r[j] == "no controller"]
-            f[f"hinfsyn_{method}_unstable_at"] = (
-                " and ".join([", ".join(unstable[:-1]), unstable[-1]]) if len(unstable) > 1
-                else "".join(unstable) or "no")
-            f[f"hinfsyn_{method}_none_at"] = ", ".join(none) or "no"
+            f[f"hinfsyn_{method}_unstable_at"] = _and(unstable)
+            f[f"hinfsyn_{method}_none_at"] = _and(none)
     ratios = [r[h["columns"].index("LMI/Riccati")] for r in h["rows"] if r[0] >= 22]
     ratios = [r for r in ratios if isinstance(r, (int, float))]
     f["hinfsyn_ratio_from_22"] = f"{min(ratios):.1f}–{max(ratios):.1f}"

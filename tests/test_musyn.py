@@ -459,9 +459,10 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     calls, checks = [], []
 
     def level(PD, bracket, rtol):
-        calls.append(riccati_level(PD, ex.nmeas, ex.ncon,
-                                   dataclasses.replace(bisection, riccati_rtol=rtol),
-                                   bracket=bracket))
+        calls.append(np.inf)  # a point that fails counts as the search counts it
+        calls[-1] = riccati_level(PD, ex.nmeas, ex.ncon,
+                                  dataclasses.replace(bisection, riccati_rtol=rtol),
+                                  bracket=bracket)
         return calls[-1]
 
     def check(PD, g):
@@ -513,8 +514,8 @@ def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     for v in full:  # the lean levels are the first search's, less the skipped points
         if v == expected:
             expected = next(lean_levels, None)
-        else:
-            assert v > next(skipped)  # which the first search found above the ceiling
+        else:  # which the first search found above the ceiling
+            assert v > next(skipped, np.inf)
     assert expected is None and next(skipped, None) is None
     # a target level ends the search at the first accepted point below it
     early = search_dscales(*args, max_evals=60, target=found.level_start * (1 - 1e-3))
@@ -590,11 +591,11 @@ def test_riccati_level_is_where_slicot_stops_finding_a_controller():
 
 def test_riccati_level_from_a_bracket_that_holds_or_misses(monkeypatch):
     """riccati_level from a bracket (the D-scale search's way) on the distillation
-    problem: whether the bracket holds, lies wholly above or below the level, or has it
-    at an end, the level found is where SLICOT's controllers start to stabilise the
+    problem: whether the bracket holds, starts at 0, lies wholly above or below the
+    level, or has it at an end, the level found is where SLICOT's controllers start to stabilise the
     loop: achieved at it and not one bisection width below (riccati_achieves, one
     synthesis each).  A bracket that holds is bisected without testing its ends first:
-    exactly one synthesis per halving."""
+    exactly one synthesis per halving; no level is synthesised twice."""
     import sys
 
     from lmi_suspension.synthesis import HinfsynOptions
@@ -614,11 +615,12 @@ def test_riccati_level_from_a_bracket_that_holds_or_misses(monkeypatch):
 
     monkeypatch.setattr(module, "_sb10ad", counted)
     holds = (g0 * (1 - 1e-3), g0 * (1 + 1e-3))
-    for bracket in (holds, (g0 * 1.01, g0 * 1.02), (g0 * 0.98, g0 * 0.99),
+    for bracket in (holds, (0.0, g0 * 2), (g0 * 1.01, g0 * 1.02), (g0 * 0.98, g0 * 0.99),
                     (g0 * (1 - 1e-3), g0 * (1 + 1e-9)), (g0 * (1 - 1e-9), g0 * (1 + 1e-3))):
         calls.clear()
         g = riccati_level(ex.P, ex.nmeas, ex.ncon, opts, bracket=bracket)
         n = len(calls)
+        assert len(set(calls)) == n  # no level synthesised twice, a missed end neither
         assert riccati_achieves(ex.P, ex.nmeas, ex.ncon, g)
         assert not riccati_achieves(ex.P, ex.nmeas, ex.ncon, g / (1 + 2 * rtol))
         assert g == pytest.approx(g0, rel=2 * rtol)

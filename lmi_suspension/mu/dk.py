@@ -190,9 +190,10 @@ class MusynOptions:
         The controller is kept only if its µ peak beats the best iterate's; ``0``
         turns the search off.  Skipped for constant scalings (``max_dfit_order = 0``),
         with constraints, and once ``mu_target`` is met; it stops as soon as an
-        accepted level is below ``mu_target``.  Each level costs about 0.05 s on
-        distillation's 22-state scaled plants (about 17 syntheses of 3 ms); a trial
-        point found above the current level costs one synthesis.  Repeated-scalar
+        accepted level is below ``mu_target``.  A level costs 15 (difference
+        quotient) to 20 (trial step) syntheses of 3-4 ms on distillation's 22-state
+        scaled plants, a trial point found above the current level one (measured
+        2026-11-28).  Repeated-scalar
         blocks are searched
         with scalings ``d(s) I``, a restriction of their D matrices (still a valid
         bound).
