@@ -171,8 +171,8 @@ class MusynOptions:
     dscale_search : int
         After the D-K loop, at most this many points (a K-step's level each) of a
         direct search on the parameters of the D-scale fits (order
-        ``max_dfit_order``), started from the
-        D-step of the *first* iterate: a descent method for the piecewise-smooth level
+        ``max_dfit_order``), started from the D-step of the *first* iterate: a
+        descent method for the piecewise-smooth level
         SLICOT's Riccati synthesis achieves on each scaled plant (BFGS on difference
         quotients, least-norm steps at kinks, every accepted point checked by a
         certified controller; :mod:`.dsearch`), the best point's controller certified at
@@ -193,10 +193,8 @@ class MusynOptions:
         accepted level is below ``mu_target``.  A level costs 15 (difference
         quotient) to 20 (trial step) syntheses of 3-4 ms on distillation's 22-state
         scaled plants, a trial point found above the current level one (measured
-        2026-11-28).  Repeated-scalar
-        blocks are searched
-        with scalings ``d(s) I``, a restriction of their D matrices (still a valid
-        bound).
+        2026-11-28).  Repeated-scalar blocks are searched with scalings ``d(s) I``, a
+        restriction of their D matrices (still a valid bound).
     complexify : bool
         Treat real scalar blocks (``[-r, 0]``) as complex in the loop (complex D-K, the
         conservative cover of a real parameter by a disc), for comparison.  By default

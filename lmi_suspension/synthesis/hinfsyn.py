@@ -296,8 +296,8 @@ def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warni
     found by factors of 4 from γ = 1 (or from a given ``bracket``) and then halved
     geometrically until it is ``riccati_rtol`` wide; with ``certify`` False a given
     bracket is halved at once and its ends are tested only where the halving never left
-    them (see the comment in the code).  Returns the controller with the lowest certified γ met on
-    the way and the lowest achieved level (with ``certify`` False no controller is
+    them (see the comment in the code).  Returns the controller with the lowest
+    certified γ met on the way and the lowest achieved level (with ``certify`` False no controller is
     certified, only its closed loop's stability checked, and ``None`` is returned in
     its place: the level alone).  python-control's ``hinfsyn`` (``sb10ad``
     job 3: bisection, then a scan down from its result) took 15 s on the 6-state
