@@ -592,10 +592,11 @@ def test_riccati_level_is_where_slicot_stops_finding_a_controller():
 def test_riccati_level_from_a_bracket_that_holds_or_misses(monkeypatch):
     """riccati_level from a bracket (the D-scale search's way) on the distillation
     problem: whether the bracket holds, starts at 0, lies wholly above or below the
-    level, or has it at an end, the level found is where SLICOT's controllers start to stabilise the
-    loop: achieved at it and not one bisection width below (riccati_achieves, one
-    synthesis each).  A bracket that holds is bisected without testing its ends first:
-    exactly one synthesis per halving; no level is synthesised twice."""
+    level, or has it at an end, the level found is where SLICOT's controllers start to
+    stabilise the loop: achieved at it and not one bisection width below
+    (riccati_achieves, one synthesis each).  A bracket that holds is bisected without
+    testing its ends first: exactly one synthesis per halving; no level is synthesised
+    twice."""
     import sys
 
     from lmi_suspension.synthesis import HinfsynOptions
