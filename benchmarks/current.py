@@ -292,7 +292,9 @@ def render(entries: list[dict]) -> str:
                 "|" + "---|" * len(e["columns"])]
         out += ["| " + " | ".join(_fmt(c) for c in row) + " |" for row in e["rows"]]
         if e.get("note"):
-            out += ["", e["note"][0].upper() + e["note"][1:] + "."]
+            # only a Latin first letter is capitalised: "µ".upper() is Greek capital Mu
+            note = e["note"]
+            out += ["", (note[0].upper() if note[0].isascii() else note[0]) + note[1:] + "."]
         if e.get("loaded"):
             out += ["", "The machine was shared during this run (load average above its "
                         "core count): its times are inflated against an idle run, the peers' "

@@ -297,9 +297,9 @@ def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warni
     geometrically until it is ``riccati_rtol`` wide; with ``certify`` False a given
     bracket is halved at once and its ends are tested only where the halving never left
     them (see the comment in the code).  Returns the controller with the lowest
-    certified γ met on the way and the lowest achieved level (with ``certify`` False no controller is
-    certified, only its closed loop's stability checked, and ``None`` is returned in
-    its place: the level alone).  python-control's ``hinfsyn`` (``sb10ad``
+    certified γ met on the way and the lowest achieved level (with ``certify`` False no
+    controller is certified, only its closed loop's stability checked, and ``None`` is
+    returned in its place: the level alone).  python-control's ``hinfsyn`` (``sb10ad``
     job 3: bisection, then a scan down from its result) took 15 s on the 6-state
     distillation plant where this takes well under a second, and its γ-optimal
     controllers are the ill-conditioned ones.
