@@ -110,9 +110,10 @@ class MusynOptions:
         posed at a level fixed in advance, 0.3 % above the norm certified for SLICOT's
         controller on the scaled plant (a feasibility problem only, then, under the
         default ``hinfsyn_options``, the explicit controller formulas, with the
-        controller LMI where they fail their certificate or pole cap).  Where the LMI finds none there, the K-step fails.
-        Where SLICOT finds none at all, it minimises γ, knowing the previous
-        controller's level on the new scaled plant: the minimisation starts in the
+        controller LMI where they fail their certificate or pole cap).  Where the LMI
+        finds none there, the K-step fails.  Where SLICOT finds none at all, it
+        minimises γ, knowing the previous controller's level on the new scaled plant:
+        the minimisation starts in the
         frame of the Riccati solutions at that level and gives up where it stops above
         it (``gamma_abort``, unless the options set one).  Where a K-step fails on an
         over-relaxed plant, the plain D-step's plant is used instead (and the

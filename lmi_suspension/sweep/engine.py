@@ -388,14 +388,15 @@ def _consolidate(out: Path, spec: SweepSpec) -> tuple[Path, int]:
 def _schema(spec: SweepSpec):
     import pyarrow as pa
 
+    from .case import METRIC_COLUMNS
+
     f64, boolean = pa.float64(), pa.bool_()
     fields = [("case", pa.int64()), ("controller", pa.string())]
     fields += [(n, f64) for n in spec.axis_names]
-    fields += [("delay_used", f64), ("stable", boolean), ("stable_sim", boolean),
-               ("peak_z3dd", f64), ("rms_z3dd", f64), ("wrms_z3dd", f64), ("vdv_z3dd", f64),
-               ("peak_x1", f64), ("x1_within_limit", boolean), ("peak_u", f64),
-               ("peak_u_command", f64), ("saturation_time", f64), ("limit_peak", f64),
-               ("limit_ratio", f64), ("seconds", f64), ("error", pa.string())]
+    # the metric columns in METRIC_COLUMNS' order: one list to extend, not two
+    other = {"stable": boolean, "stable_sim": boolean, "x1_within_limit": boolean,
+             "error": pa.string()}
+    fields += [(c, other.get(c, f64)) for c in METRIC_COLUMNS]
     return pa.schema(fields)
 
 

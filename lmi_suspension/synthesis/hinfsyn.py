@@ -383,7 +383,11 @@ def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warni
 
 
 def _stabilises(G: GeneralizedPlant, K) -> bool:
-    """Whether ``K`` stabilises the loop on ``G`` (its closed-loop poles only)."""
+    """Whether ``K`` stabilises the loop on ``G`` (its closed-loop poles only).
+
+    Strictly ``Re p < 0``, not :func:`~lmi_suspension.lti.norms.is_stable` with its
+    margin: the level the D-scale search minimises was measured reproducible with this
+    test (``riccati_level``), and a margin would move it."""
     return bool(np.all(np.real(np.linalg.eigvals(np.asarray(lft(G, K).A))) < 0))
 
 

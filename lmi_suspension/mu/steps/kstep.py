@@ -338,8 +338,9 @@ def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base, controller: str = "
     LMI finds none at the level within ``_LEVEL_LED_RECOVERIES`` recoveries.
 
     :func:`_k_step` passes ``controller=_LEVEL_LED_CONTROLLER`` (``"explicit"``) under
-    the default K-step options, the user's choice otherwise: a feasibility problem's point is interior, not
-    the γ optimum's, and the explicit formulas are well conditioned there.
+    the default K-step options, the user's choice otherwise: a feasibility problem's
+    point is interior, not the γ optimum's, and the explicit formulas are well
+    conditioned there.
 
     On the D-scaled plants of the distillation problem the γ minimisation is where the
     LMI K-step loses its time and its reproducibility (9-70 s on 22 states, γ 1.0113 to
