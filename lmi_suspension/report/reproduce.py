@@ -419,7 +419,8 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     largest delay; for the exported controller (``controller.json``), a seeded Monte-Carlo
     over the occupant set (mass, springs and dampers) with delays drawn from
     ``[0, max(delays)]`` (the sample of the largest peak reported, also against its
-    own limit) and the occupant map: a grid sweep of ``m3`` × ``k1`` reaching past the set, at the map's own delays
+    own limit) and the occupant map: a grid sweep of ``m3`` × ``k1`` reaching past the
+    set, at the map's own delays
     (0 and 25 ms whatever ``delays``; 25 ms with ``quick``), each cell's peak over its
     own physical limit and its exact-delay stability, with the worst seat in the set
     replayed for its figure.
