@@ -17,10 +17,11 @@ from matplotlib.image import imread
 from lmi_suspension.errors import AssumptionError, ParameterError
 from lmi_suspension.io import load_controller
 from lmi_suspension.mu.dk import MusynIteration
-from lmi_suspension.seat.constrained import ConstrainedCheck
-from lmi_suspension.seat.design import MuCheck, SeatMuDesign
+from lmi_suspension.seat.constrained import CONSTRAINED_DESIGN, ConstrainedCheck
+from lmi_suspension.seat.design import MuCheck, SeatMuDesign, _dk_line
 from lmi_suspension.seat.multimodel import SHIPPED_OCCUPANTS
 from lmi_suspension.seat.occupants import OccupantSet
+from lmi_suspension.seat.routes import SeatCertificate, seat_design_from
 from lmi_suspension.seat.sampled import discretise_controller, simulate_sampled
 from lmi_suspension.sweep import read_results
 from lmi_suspension.seat import (
@@ -53,6 +54,10 @@ K_REFINED = control.ss([[-250.0]], [[250.0, 0.0]], [[6000.0]], [[0.0, 800.0]])
 K_OCCUPANTS = load_controller(SHIPPED_OCCUPANTS)[0]
 
 
+def _same(K1, K2) -> bool:
+    return all(np.array_equal(getattr(K1, m), getattr(K2, m)) for m in "ABCD")
+
+
 def _stand_in(fail_riccati=False, fail_occupants=False):
     # Low-passed extra stiffness on x1 and a little on x3: a stable loop with a finite
     # delay margin, unlike any µ design, so wrong wiring shows up in the numbers.
@@ -65,16 +70,20 @@ def _stand_in(fail_riccati=False, fail_occupants=False):
     upper = 0.4 + 0.3 * np.exp(-np.log(omega / 12.0) ** 2)
     calls = []
 
-    def design_mu_controller(design=None, *, params=None, musyn_options=None, omega_=None,
-                             callback=None, rng=None):
+    def design_seat(route="mu", *, params=None, rng=None, progress=None):
+        assert route == "mu", route
         calls.append(rng)
         for rec in history:
-            if callback is not None:
-                callback(rec)
-        return SeatMuDesign(K=K_mu, aug=SimpleNamespace(options=SeatDesignOptions()),
-                       musyn=SimpleNamespace(history=history), mu_peak=float(upper.max()),
-                       mu_lower_peak=float(0.9 * upper.max()), omega=omega, mu_upper=upper,
-                       mu_lower=0.9 * upper, seconds=0.0)
+            if progress is not None:
+                progress(_dk_line(rec))
+        detail = SeatMuDesign(K=K_mu, aug=SimpleNamespace(options=SeatDesignOptions()),
+                              musyn=SimpleNamespace(history=history),
+                              mu_peak=float(upper.max()),
+                              mu_lower_peak=float(0.9 * upper.max()), omega=omega,
+                              mu_upper=upper, mu_lower=0.9 * upper, seconds=0.0)
+        return seat_design_from("mu", K_mu, params=params, weights=SeatDesignOptions(),
+                                figures={}, description="stand-in µ", seconds=0.0,
+                                detail=detail)
 
     def design_nominal_hinf(design=None, *, params=None, method="lmi"):
         if method == "riccati" and fail_riccati:
@@ -91,20 +100,15 @@ def _stand_in(fail_riccati=False, fail_occupants=False):
         return (MuCheck("as designed", ("delay", "performance"), 0.7, 0.69, 12.0),
                 MuCheck("+ paper", ("delay", "nb_AB", "performance"), 0.8, 0.79, 13.0))
 
-    def load_constrained():
-        Kd = discretise_controller(K_CONSTRAINED, 1e-3)
-        return K_CONSTRAINED, Kd, {"description": "stand-in", "u_bound": 4000.0}
-
-    def load_refined():
-        Kd = discretise_controller(K_REFINED, 1e-3)
-        return K_REFINED, Kd, {"description": "stand-in refined", "u_bound": 1500.0}
-
-    def load_occupants():
-        if fail_occupants:
+    def load_seat_design(route):
+        if route == "occupants" and fail_occupants:
             raise OSError("stand-in: mu_occupants.json missing")
-        Kd = discretise_controller(K_OCCUPANTS, 1e-3)
-        return K_OCCUPANTS, Kd, {"description": "stand-in occupants", "u_bound": 1500.0,
-                                 "discretisation": "Tustin, dt = 0.001 s"}
+        K, weights, u_bound = {"constrained": (K_CONSTRAINED, CONSTRAINED_DESIGN, 4000.0),
+                               "refined": (K_REFINED, SeatDesignOptions(), 1500.0),
+                               "occupants": (K_OCCUPANTS, SeatDesignOptions(), 1500.0)}[route]
+        return seat_design_from(route, K, params=None, weights=weights,
+                                figures={"u_bound": u_bound}, seconds=0.0,
+                                description=f"stand-in {route}")
 
     def load_refined_tradeoff():
         calls.append("tradeoff")
@@ -113,22 +117,24 @@ def _stand_in(fail_riccati=False, fail_occupants=False):
                        for b, p in ((1500.0, 8.8), (2000.0, 6.3)))
         return points, {"points": []}
 
-    def certify_constrained(K, design=None, rng=None):
-        calls.append("certify" if design is None else "certify refined")
-        return ConstrainedCheck(mu_peak=1.2, mu_lower_peak=1.1, omega=omega,
-                                mu_upper=1.2 * upper / upper.max(),
-                                mu_lower=1.1 * upper / upper.max(), u_peak=3000.0,
-                                x1_peak=0.05, energy=0.45, fastest_pole=150.0,
-                                controller_fastest_pole=150.0)
+    def certify_seat(K, *, Kd=None, params=None, design=None, delays=(), rng=None):
+        # which controller, with which µ weights (the file's own)
+        calls.append(("certify", K, design))
+        mu = ConstrainedCheck(mu_peak=1.2, mu_lower_peak=1.1, omega=omega,
+                              mu_upper=1.2 * upper / upper.max(),
+                              mu_lower=1.1 * upper / upper.max(), u_peak=3000.0,
+                              x1_peak=0.05, energy=0.45, fastest_pole=150.0,
+                              controller_fastest_pole=150.0)
+        return SeatCertificate(delays=tuple(delays), peak=(), u_peak=(), x1_peak=(),
+                               sampled_peak=(), mu=mu, delay_margin=math.inf,
+                               loop_radius=150.0)
 
-    api = SimpleNamespace(design_mu_controller=design_mu_controller,
+    api = SimpleNamespace(design_seat=design_seat,
                           design_nominal_hinf=design_nominal_hinf,
                           analyse_uncertainty=analyse_uncertainty,
-                          load_constrained=load_constrained,
-                          load_refined=load_refined,
-                          load_occupants=load_occupants,
+                          load_seat_design=load_seat_design,
                           load_refined_tradeoff=load_refined_tradeoff,
-                          certify_constrained=certify_constrained,
+                          certify_seat=certify_seat,
                           DEFAULT_DESIGN=SeatDesignOptions(), DEFAULT_MUSYN=None)
     return api, K_mu, history, calls
 
@@ -397,8 +403,10 @@ def test_constrained_row_reports_commanded_force_and_the_sampled_loop(run):
     sampled = simulate_sampled(discretise_controller(K_CONSTRAINED, 1e-3), road, delay=0.025)
     assert c.sampled_peak_z3dd[-1] == pytest.approx(np.max(np.abs(sampled.z3dd)), rel=1e-12)
     data = json.loads((run.out / "summary.json").read_text())
-    assert data["mu_constrained"]["check"]["mu_peak"] == 1.2
-    assert "certify" in run.calls
+    assert data["mu_constrained"]["check"]["mu"]["mu_peak"] == 1.2
+    # certified with its own µ weights (the constrained design's force scaling)
+    assert any(c[0] == "certify" and _same(c[1], K_CONSTRAINED) and c[2] == CONSTRAINED_DESIGN
+               for c in run.calls if isinstance(c, tuple))
 
 
 @pytest.mark.slow
@@ -407,7 +415,8 @@ def test_refined_row_is_simulated_and_certified_with_the_paper_weights(run):
     _road, direct = _bump_at_25ms(K_REFINED)
     assert c.peak_z3dd[-1] == pytest.approx(np.max(np.abs(direct.z3dd)), rel=1e-12)
     assert len(c.sampled_peak_z3dd) == len(c.delays)
-    assert "certify refined" in run.calls
+    assert any(c[0] == "certify" and _same(c[1], K_REFINED) and c[2] == SeatDesignOptions()
+               for c in run.calls if isinstance(c, tuple))
 
 
 @pytest.mark.slow
@@ -537,13 +546,13 @@ def test_roads_and_monte_carlo_do_not_depend_on_the_design_draws(monkeypatch, tm
     results = []
     for draws in (0, 1000):
         api, *_ = _stand_in()
-        design = api.design_mu_controller
+        design = api.design_seat
 
         def drawing_design(*args, rng=None, _d=design, _n=draws, **kwargs):
             rng.standard_normal(_n)
             return _d(*args, rng=rng, **kwargs)
 
-        api.design_mu_controller = drawing_design
+        api.design_seat = drawing_design
         monkeypatch.setattr(R, "_design_api", lambda api=api: api)
         out = tmp_path / f"draws{draws}"
         R.reproduce(out, rng=np.random.default_rng(3), delays=(0.0,), quick=True)

@@ -615,6 +615,25 @@ def test_design_entry_synthesises_one_controller_per_distinct_seat(tmp_path, mon
         assert row["stable"] == closed_loop_stable(K, row["delay"], SeatParameters(m3=60.0))
 
 
+def test_a_design_entry_can_name_any_route(tmp_path):
+    """``design:<route>``: the peak-bounded route designed for each seat of the grid (once
+    each), its rows equal to a direct design and simulation."""
+    from lmi_suspension.seat.routes import design_seat
+
+    spec = SweepSpec(controllers=("design:peak_bounded",), grid=(("m3", (35.0, 65.0)),),
+                     duration=0.5, limit=False)
+    res = run_sweep(spec, tmp_path, workers=0, figures=False)
+    rows = read_results(tmp_path)[0].to_pylist()
+    assert res.n_failed == 0 and [r["controller"] for r in rows] == [spec.controllers[0]] * 2
+    for row in rows:
+        p = SeatParameters(m3=row["m3"])
+        K = design_seat("peak_bounded", params=p).K
+        m = simulate(K, bump(t_end=0.5), params=p, dt=SIM_STEP).metrics()
+        assert row["peak_z3dd"] == pytest.approx(m.peak_z3dd, rel=1e-9)
+    with pytest.raises(ParameterError, match="unknown design route 'nope'"):
+        SweepSpec(controllers=("design:nope",))
+
+
 def test_step_sets_the_simulation_and_the_delay_rounding(tmp_path):
     spec = SweepSpec(grid=(("delay", (0.0123,)),), duration=0.4, limit=False, step=5e-4)
     assert spec.cases()[0].values["delay"] == round(0.0123 / 5e-4) * 5e-4

@@ -338,17 +338,14 @@ def _design_api():
     """The seat designs (imported late: they are heavy, and tests replace them)."""
     from types import SimpleNamespace
 
-    from ..seat import constrained, design, multimodel, refine
+    from ..seat import design, refine, routes
     return SimpleNamespace(
-        load_refined=refine.load_refined,
-        load_occupants=lambda: refine.load_refined(multimodel.SHIPPED_OCCUPANTS),
+        design_seat=routes.design_seat, load_seat_design=routes.load_seat_design,
+        certify_seat=routes.certify_seat,
         load_refined_tradeoff=refine.load_refined_tradeoff,
-        design_mu_controller=design.design_mu_controller,
         analyse_uncertainty=design.analyse_uncertainty,
         design_nominal_hinf=design.design_nominal_hinf,
-        DEFAULT_DESIGN=design.DEFAULT_DESIGN, DEFAULT_MUSYN=design.DEFAULT_MUSYN,
-        load_constrained=constrained.load_constrained,
-        certify_constrained=constrained.certify_constrained)
+        DEFAULT_DESIGN=design.DEFAULT_DESIGN, DEFAULT_MUSYN=design.DEFAULT_MUSYN)
 
 
 def _jsonable(obj):
@@ -526,13 +523,9 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     # --- µ design --------------------------------------------------------------------
     tok = stage("mu_design", "µ design (D-K iteration) ...")
 
-    def on_iteration(rec):
-        what = "D-K iteration" if rec.stage == "dk" else "D-scale search, record"
-        say(f"  {what} {rec.index}: gamma = {rec.gamma:.4f}, µ upper = "
-            f"{rec.mu_peak:.4f}, µ lower = {rec.mu_lower_peak:.4f} "
-            f"({rec.seconds_k + rec.seconds_d + rec.seconds_fit:.1f} s)")
-
-    mu_design = api.design_mu_controller(callback=on_iteration, rng=rng_design)
+    # the µ route's own result (its D-K history, dense-grid bounds) is the design's detail
+    mu_design = api.design_seat("mu", params=params, rng=rng_design,
+                                progress=lambda line: say("  " + line)).detail
     done(tok)
     say(f"  µ peak upper {mu_design.mu_peak:.4f}, lower {mu_design.mu_lower_peak:.4f}, "
         f"controller order {mu_design.K.nstates}")
@@ -544,19 +537,24 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     done(tok)
 
     # --- the shipped designs (their searches take minutes): loaded and re-certified ----
+    # every route alike: its file read by load_seat_design, its µ bounds, worst cases and
+    # poles recomputed by certify_seat with the design's own µ weights (the bump is
+    # simulated below with every other controller)
     errors: dict[str, str] = {}
 
-    def shipped(name, message, load, describe, **certify):
+    def shipped(name, route, message, describe):
         tok = stage(name, message)
         result = None
         try:
-            K_s, Kd_s, meta_s = load()
-            check = api.certify_constrained(K_s, rng=np.random.default_rng(
-                int(rng_analysis.integers(2**63))), **certify)
-            result = (K_s, Kd_s, meta_s, check)
-            say(f"  µ upper {check.mu_peak:.4f}, lower {check.mu_lower_peak:.4f}; "
-                + describe(check) + f"fastest pole {check.fastest_pole:.0f} rad/s "
-                f"(controller {check.controller_fastest_pole:.0f})")
+            d = api.load_seat_design(route)
+            cert = api.certify_seat(d.K, Kd=d.Kd, params=d.params, design=d.weights,
+                                    delays=(), rng=np.random.default_rng(
+                                        int(rng_analysis.integers(2**63))))
+            result = (d, cert)
+            c = cert.mu
+            say(f"  µ upper {c.mu_peak:.4f}, lower {c.mu_lower_peak:.4f}; "
+                + describe(c) + f"fastest pole {c.fastest_pole:.0f} rad/s "
+                f"(controller {c.controller_fastest_pole:.0f})")
         except (LmiSuspensionError, OSError) as exc:
             errors[name] = f"{type(exc).__name__}: {exc}"
             say(f"  {name} failed: {errors[name]}")
@@ -564,17 +562,16 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         return result
 
     constrained = shipped(
-        "mu_constrained", "µ design with hard force/stroke bounds (shipped, re-certified) ...",
-        api.load_constrained,
+        "mu_constrained", "constrained",
+        "µ design with hard force/stroke bounds (shipped, re-certified) ...",
         lambda c: (f"worst case over floor velocities of the bump's energy: |u| "
                    f"{c.u_peak:.0f} N, |x1| {c.x1_peak:.4f} m; "))
     refined = shipped(
-        "mu_refined", "µ controller refined to the force/stroke/pole bounds (shipped, "
-        "re-certified) ...", api.load_refined, lambda c: "", design=api.DEFAULT_DESIGN)
+        "mu_refined", "refined", "µ controller refined to the force/stroke/pole bounds "
+        "(shipped, re-certified) ...", lambda c: "")
     occupants = shipped(
-        "mu_occupants", "seat controller for every occupant, spring and delay of the set "
-        "(shipped, re-certified) ...", api.load_occupants, lambda c: "",
-        design=api.DEFAULT_DESIGN)
+        "mu_occupants", "occupants", "seat controller for every occupant, spring and "
+        "delay of the set (shipped, re-certified) ...", lambda c: "")
 
     # --- comparison controllers ------------------------------------------------------
     controllers: dict[str, object] = {"passive": None}
@@ -588,12 +585,10 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         done(tok)
     controllers["mu"] = mu_design.K
     discrete = {}
-    if constrained is not None:
-        controllers["mu_constrained"], discrete["mu_constrained"] = constrained[:2]
-    if refined is not None:
-        controllers["mu_refined"], discrete["mu_refined"] = refined[:2]
-    if occupants is not None:
-        controllers["mu_occupants"], discrete["mu_occupants"] = occupants[:2]
+    for name, loaded in (("mu_constrained", constrained), ("mu_refined", refined),
+                         ("mu_occupants", occupants)):
+        if loaded is not None:
+            controllers[name], discrete[name] = loaded[0].K, loaded[0].Kd
 
     # --- roads and the physical limit ------------------------------------------------
     road_bump = bump(t_end=cfg.bump_t_end, dt=cfg.road_dt)
@@ -717,13 +712,13 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     if exported == "mu":
         K_export, meta_export = mu_design.K, dict(metadata)
     else:
-        K_export, meta_export = occupants[0], dict(occupants[2])
+        K_export, meta_export = occupants[0].K, occupants[0].metadata()
         # controllers/mu_occupants.json holds the 1 kHz realization; this file does not
         meta_export.pop("discretisation", None)
         # what this run recomputed: µ with the paper's weights at the nominal seat (the
         # set's mixed µ is the design's own certificate, not recomputed here)
-        meta_export["paper_mu_nominal_seat"] = {"upper": occupants[3].mu_peak,
-                                                "lower": occupants[3].mu_lower_peak}
+        meta_export["paper_mu_nominal_seat"] = {"upper": occupants[1].mu.mu_peak,
+                                                "lower": occupants[1].mu.mu_lower_peak}
     meta_export.update(exported_as=exported, version=__version__)
     files.append(save_controller(out / "controller.json", K_export, inputs=["x1", "x3"],
                                  outputs=["u"], metadata=_jsonable(meta_export)))
@@ -743,7 +738,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         loaded = {"mu_constrained": constrained, "mu_refined": refined,
                   "mu_occupants": occupants}.get(name)
         meta = dict(metadata) if name == "mu" else (
-            dict(loaded[2]) if loaded is not None else
+            loaded[0].metadata() if loaded is not None else
             {"description": f"{_LONG_NAMES[name]}: y = [x1, x3] (m) -> u (N)"})
         meta["fastest_pole"] = fastest_pole(K)
         files.append(save_controller(out / "controllers" / f"{name}.json", K,
@@ -831,12 +826,12 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                                             "force"),
          "force_commanded_vs_applied.png")
     if constrained is not None:
-        check_c = constrained[3]
+        check_c = constrained[1].mu
         save(figures.plot_mu_bounds(check_c.omega, check_c.mu_upper, check_c.mu_lower,
                                     title="µ bounds, µ design with hard force/stroke bounds"),
              "mu_bounds_constrained.png")
     if refined is not None:
-        check_r = refined[3]
+        check_r = refined[1].mu
         save(figures.plot_mu_bounds(check_r.omega, check_r.mu_upper, check_r.mu_lower,
                                     title="µ bounds, µ controller refined to the bounds"),
              "mu_bounds_refined.png")
@@ -912,12 +907,10 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                "design_seconds": getattr(mu_design, "seconds", None)},
         "design_options": metadata["design_options"],
         "musyn_options": metadata["musyn_options"],
-        "mu_constrained": None if constrained is None else {
-            "check": constrained[3], "design": constrained[2]},
-        "mu_refined": None if refined is None else {
-            "check": refined[3], "design": refined[2]},
-        "mu_occupants": None if occupants is None else {
-            "check": occupants[3], "design": occupants[2]},
+        **{name: None if loaded is None else {"check": loaded[1],
+                                               "design": loaded[0].metadata()}
+           for name, loaded in (("mu_constrained", constrained), ("mu_refined", refined),
+                                ("mu_occupants", occupants))},
         "exported": exported,
         "occupant_map": map_data,
         "timings": timings,

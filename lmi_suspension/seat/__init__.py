@@ -5,8 +5,10 @@ roads -> exact-delay simulation -> comfort metrics; the physical limit of the bu
 The designs: :mod:`.design` (µ-synthesis as in the paper), :mod:`.constrained` (hard
 force and stroke bounds in the K-step), :mod:`.refine` (the µ controller refined to the
 exact bump requirements), :mod:`.multimodel` (that refinement over a set of seats, with
-a worst-case search) and :mod:`.sampled` (the 1 kHz implementation); :mod:`.occupants`
-is the set of seats a controller must serve and its certificate over them.
+a worst-case search), :mod:`.bounded` (H∞ with peak bounds) and :mod:`.sampled` (the
+1 kHz implementation); :mod:`.occupants` is the set of seats a controller must serve and
+its certificate over them.  :mod:`.routes` is the one entry to them all
+(:func:`design_seat`, :class:`SeatDesign`, :func:`certify_seat`).
 """
 
 from .augmented import BUMP_PEAK_VELOCITY, SeatAugmentedPlant, SeatDesignOptions, seat_augmented_plant
@@ -24,7 +26,10 @@ from .bounded import PeakBoundedDesign, design_peak_bounded, road_energy
 # the designs' own modules, documented as modules: the µ design, its constrained K-step
 # route, the refinement (on one seat and on a set), the set of seats and its certificate,
 # and the sampled-data implementation
-from . import constrained, design, multimodel, occupants, refine, sampled
+from . import constrained, design, multimodel, occupants, refine, routes, sampled
+# one entry for every route: design_seat, the SeatDesign it returns, certify_seat
+from .routes import (SeatCertificate, SeatDesign, SeatRequirements, SeatRoute, certify_seat,
+                     design_seat, load_seat_design, save_seat_design)
 
 __all__ = [
     "SeatParameters", "SeatMatrices", "seat_matrices", "seat_model", "natural_modes",
@@ -39,4 +44,6 @@ __all__ = [
     "LimitResult", "bump_limit",
     "PeakBoundedDesign", "design_peak_bounded", "road_energy",
     "design", "constrained", "refine", "multimodel", "occupants", "sampled",
+    "SeatRoute", "SeatDesign", "SeatRequirements", "SeatCertificate", "design_seat",
+    "certify_seat", "save_seat_design", "load_seat_design", "routes",
 ]

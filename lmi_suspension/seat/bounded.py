@@ -24,6 +24,7 @@ column alone (``u`` and ``x1`` rows).  ``rho`` and ``eps`` make the H∞ problem
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import control
 import numpy as np
@@ -38,7 +39,7 @@ from .roads import RoadInput, bump
 from .simulate import SimulationResult, simulate
 
 __all__ = ["PeakBoundedDesign", "seat_peak_plant", "road_energy", "design_peak_bounded",
-           "force_tradeoff"]
+           "force_tradeoff", "PeakBoundedRoute"]
 
 #: control penalty (per N) and measurement noise (m per unit of w) that regularise the H∞
 #: problem. Measured 2026-11-26 (certified H∞, fastest controller pole): at 1e-2 each,
@@ -188,3 +189,37 @@ def force_tradeoff(u_bounds, z_max: float = 0.08, *, energy: float | None = None
     """:func:`design_peak_bounded` for each force bound (the trade-off of issue 16);
     ``numpy.inf`` in ``u_bounds`` gives the design with the stroke bound alone."""
     return [design_peak_bounded(u, z_max, energy=energy, params=params) for u in u_bounds]
+
+
+@dataclass(frozen=True)
+class PeakBoundedRoute:
+    """H∞ comfort with hard force and stroke bounds by multi-objective LMIs
+    (:func:`design_peak_bounded`; no delay in the design) as a
+    :class:`~.routes.SeatRoute`.
+
+    Examples
+    --------
+    >>> PeakBoundedRoute().name
+    'peak_bounded'
+    """
+
+    name: ClassVar[str] = "peak_bounded"
+    u_max: float = 1500.0
+    z_max: float = 0.08
+
+    def design(self, params: SeatParameters, *, rng=None, progress=None):
+        import time
+
+        from .routes import seat_design_from
+
+        t0 = time.perf_counter()
+        d = design_peak_bounded(self.u_max, self.z_max, params=params)
+        return seat_design_from(
+            self.name, d.K, params=params, weights=None, seconds=time.perf_counter() - t0,
+            detail=d,
+            description=(f"H∞ seat controller with |u| <= {d.u_max:g} N and |x1| <= "
+                         f"{d.z_max:g} m for every floor velocity of the bump's energy "
+                         f"(no delay): y = [x1, x3] (m) -> u (N)"),
+            figures={"hinf": d.hinf, "hinf_lmi": d.hinf_lmi, "u_max": d.u_max,
+                     "z_max": d.z_max, "energy": d.energy, "u_peak": d.u_peak,
+                     "x1_peak": d.x1_peak})

@@ -34,6 +34,7 @@ import logging
 import time
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
+from typing import ClassVar
 
 import control
 import numpy as np
@@ -42,7 +43,7 @@ from ..mu import MusynOptions, MusynResult, musyn
 from ..synthesis.constraints import Channel, Disk, PeakBound
 from .augmented import SeatDesignOptions, seat_augmented_plant
 from .bounded import road_energy
-from .design import DEFAULT_DESIGN, DEFAULT_OMEGA, _named
+from .design import DEFAULT_DESIGN, _named
 from .params import SeatParameters
 from .roads import bump
 from .sampled import DEFAULT_SAMPLE_TIME, discretise_controller
@@ -51,7 +52,7 @@ __all__ = ["ConstrainedMuDesign", "ConstrainedCheck", "CONSTRAINED_MUSYN",
            "CONSTRAINED_DESIGN", "CONSTRAINED_OMEGA", "TRADEOFF_DELAYS", "TradeoffPoint",
            "bump_figures", "certify_constrained", "constrained_tradeoff",
            "design_constrained_mu", "load_constrained", "load_tradeoff", "save_constrained",
-           "SHIPPED_CONTROLLER", "SHIPPED_TRADEOFF"]
+           "SHIPPED_CONTROLLER", "SHIPPED_TRADEOFF", "ConstrainedRoute"]
 
 #: the constrained design shipped with the package (``lmi-suspension design-constrained``
 #: writes it; ``reproduce`` loads and re-certifies it)
@@ -307,24 +308,62 @@ def design_constrained_mu(u_bound: float = 9000.0, z_bound: float = 0.16, *,
         seconds=seconds)
 
 
+_CONSTRAINED_DESCRIPTION = ("µ-synthesis seat controller with hard force/stroke bounds and a "
+                            "pole disk in every K-step: y = [x1, x3] (m) -> u (N)")
+
+
+def _figures(d: ConstrainedMuDesign) -> dict:
+    """What a constrained design claims, as saved in its file's metadata."""
+    return {"mu_peak_upper": d.mu_peak, "mu_peak_lower": d.mu_lower_peak,
+            "u_bound": d.u_bound, "z_bound": d.z_bound, "energy": d.energy,
+            "disk_radius": d.disk_radius, "u_peak": d.u_peak, "x1_peak": d.x1_peak,
+            "history": [{"index": h.index, "gamma": h.gamma, "mu_peak": h.mu_peak,
+                         "mu_lower_peak": h.mu_lower_peak}
+                        for h in d.musyn.history],
+            "stop_reason": d.musyn.stop_reason}
+
+
 def save_constrained(path, d: ConstrainedMuDesign) -> Path:
     """Write a constrained design as a controller file (``controller.json``'s format with
     the discrete realization and the design's figures in its metadata)."""
     from ..io import save_controller
 
-    meta = {"description": "µ-synthesis seat controller with hard force/stroke bounds and a "
-                           "pole disk in every K-step: y = [x1, x3] (m) -> u (N)",
-            "mu_peak_upper": d.mu_peak, "mu_peak_lower": d.mu_lower_peak,
-            "u_bound": d.u_bound, "z_bound": d.z_bound, "energy": d.energy,
-            "disk_radius": d.disk_radius, "u_peak": d.u_peak, "x1_peak": d.x1_peak,
-            "discretisation": f"Tustin, dt = {d.Kd.dt} s",
-            "design_seconds": d.seconds,
-            "history": [{"index": h.index, "gamma": h.gamma, "mu_peak": h.mu_peak,
-                         "mu_lower_peak": h.mu_lower_peak}
-                        for h in d.musyn.history],
-            "stop_reason": d.musyn.stop_reason}
+    meta = {"description": _CONSTRAINED_DESCRIPTION, **_figures(d),
+            "discretisation": f"Tustin, dt = {d.Kd.dt} s", "design_seconds": d.seconds}
     return save_controller(path, d.K, inputs=["x1", "x3"], outputs=["u"], metadata=meta,
                            discrete=d.Kd)
+
+
+@dataclass(frozen=True)
+class ConstrainedRoute:
+    """µ-synthesis with hard force, stroke and pole bounds in every K-step
+    (:func:`design_constrained_mu`) as a :class:`~.routes.SeatRoute`.
+
+    Examples
+    --------
+    >>> ConstrainedRoute(u_bound=1500.0).name
+    'constrained'
+    """
+
+    name: ClassVar[str] = "constrained"
+    u_bound: float = 9000.0
+    z_bound: float = 0.16
+    disk_radius: float | None = 2000.0
+    design_options: SeatDesignOptions | None = None
+    musyn_options: MusynOptions | None = None
+
+    def design(self, params: SeatParameters, *, rng: np.random.Generator, progress=None):
+        from .design import _dk_line
+        from .routes import seat_design_from
+
+        cb = None if progress is None else (lambda rec: progress(_dk_line(rec)))
+        weights = CONSTRAINED_DESIGN if self.design_options is None else self.design_options
+        d = design_constrained_mu(self.u_bound, self.z_bound, disk_radius=self.disk_radius,
+                                  design=weights, params=params,
+                                  musyn_options=self.musyn_options, callback=cb, rng=rng)
+        return seat_design_from(self.name, d.K, Kd=d.Kd, params=params, weights=weights,
+                                seconds=d.seconds, detail=d,
+                                description=_CONSTRAINED_DESCRIPTION, figures=_figures(d))
 
 
 def load_constrained(path=None) -> tuple:

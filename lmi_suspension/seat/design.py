@@ -39,6 +39,7 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass, replace
+from typing import ClassVar
 
 import control
 import numpy as np
@@ -47,7 +48,7 @@ from ..mu import MusynOptions, MusynResult, musyn
 from .augmented import SeatAugmentedPlant, SeatDesignOptions, seat_augmented_plant
 from .params import SeatParameters
 
-__all__ = ["DEFAULT_DESIGN", "DEFAULT_MUSYN", "DEFAULT_OMEGA", "MuCheck", "SeatMuDesign",
+__all__ = ["DEFAULT_DESIGN", "DEFAULT_MUSYN", "DEFAULT_OMEGA", "MuCheck", "MuRoute", "SeatMuDesign",
            "analyse_uncertainty", "design_mu_controller", "design_nominal_hinf"]
 
 logger = logging.getLogger(__name__)
@@ -295,6 +296,42 @@ def analyse_uncertainty(K: control.StateSpace, design: SeatDesignOptions | None 
         logger.info("seat µ analysis (%s): %.4f (lower %.4f)", label, upper[k],
                     np.max(bounds.lower))
     return tuple(checks)
+
+
+def _dk_line(rec) -> str:
+    """One line of progress for a D-K record (an iteration, or a D-scale search record)."""
+    what = "D-K iteration" if rec.stage == "dk" else "D-scale search, record"
+    return (f"{what} {rec.index}: gamma {rec.gamma:.4f}, µ upper {rec.mu_peak:.4f}, "
+            f"lower {rec.mu_lower_peak:.4f} ({rec.seconds_k + rec.seconds_d + rec.seconds_fit:.1f} s)")
+
+
+@dataclass(frozen=True)
+class MuRoute:
+    """The paper's route: µ-synthesis by D-K iteration (:func:`design_mu_controller`) as
+    a :class:`~.routes.SeatRoute`.  Unset fields take that function's defaults.
+
+    Examples
+    --------
+    >>> MuRoute().name
+    'mu'
+    """
+
+    name: ClassVar[str] = "mu"
+    design_options: SeatDesignOptions | None = None
+    musyn_options: MusynOptions | None = None
+
+    def design(self, params: SeatParameters, *, rng: np.random.Generator, progress=None):
+        from .routes import seat_design_from
+
+        cb = None if progress is None else (lambda rec: progress(_dk_line(rec)))
+        d = design_mu_controller(self.design_options, params=params,
+                                 musyn_options=self.musyn_options, callback=cb, rng=rng)
+        return seat_design_from(
+            self.name, d.K, params=params, weights=d.aug.options, seconds=d.seconds,
+            detail=d, description="µ-synthesis seat controller (D-K iteration, delay cover "
+                        "0–25 ms): y = [x1, x3] (m) -> u (N)",
+            figures={"mu_peak_upper": d.mu_peak, "mu_peak_lower": d.mu_lower_peak,
+                     "stop_reason": d.musyn.stop_reason})
 
 
 def design_nominal_hinf(design: SeatDesignOptions | None = None, *,

@@ -26,18 +26,20 @@ import logging
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Callable
+from typing import Callable, ClassVar
 
 import control
 import numpy as np
 
 from ..errors import ParameterError
+from .augmented import SeatDesignOptions
 from .occupants import OccupantSet
 from .refine import (_LIMIT_DT, BumpResponse, RefinedDesign, RefineOptions, loop_poles,
                      refine_seat_controller)
 from .roads import RoadInput, bump
 
-__all__ = ["OccupantRound", "OccupantDesign", "SHIPPED_OCCUPANTS", "refine_for_occupants"]
+__all__ = ["OccupantRound", "OccupantDesign", "OccupantRoute", "SHIPPED_OCCUPANTS",
+           "refine_for_occupants"]
 
 logger = logging.getLogger(__name__)
 
@@ -209,3 +211,71 @@ def refine_for_occupants(K0, occupants: OccupantSet | None = None,
         plants = tuple(plants) + added
     return OccupantDesign(K=K, design=history[-1].design, rounds=tuple(history),
                           seconds=time.perf_counter() - t0)
+
+
+def _round_line(r: OccupantRound) -> str:
+    return (f"round {r.index}: {len(r.plants) + 1} seats, worst peak/limit "
+            f"{np.max(r.design.peak):.3f}, |u| {np.max(r.design.u_peak):.0f} N, met "
+            f"{r.design.met}; search: worst {r.worst_found:.3f}, {r.violations_found} "
+            f"violations, {len(r.added)} seats added ({r.seconds:.0f} s)")
+
+
+@dataclass(frozen=True)
+class OccupantRoute:
+    """The refinement over a set of seats with a worst-case search
+    (:func:`refine_for_occupants`) as a :class:`~.routes.SeatRoute`.
+
+    Attributes
+    ----------
+    occupants : OccupantSet, optional
+        The set (30–70 kg, springs and dampers ±20 %, delay 0–25 ms around the seat
+        designed for, by default).
+    options : RefineOptions, optional
+        The requirements; by default those of :class:`~.refine.RefineOptions` with the
+        set's mixed µ of robust stability required and the µ of robust performance
+        replaced by the delay cover's gain (``mu_performance=False``), as the shipped
+        design was made.
+    start : SeatRoute or control.StateSpace, optional
+        The start controller or the route that designs it (the µ route by default).
+    rounds, n_search, add : int
+        As :func:`refine_for_occupants`.
+    design_options : SeatDesignOptions, optional
+        The µ weights and delay cover of the refinement
+        (:data:`~.design.DEFAULT_DESIGN` by default).
+
+    Examples
+    --------
+    >>> OccupantRoute().name
+    'occupants'
+    """
+
+    name: ClassVar[str] = "occupants"
+    occupants: OccupantSet | None = None
+    options: RefineOptions | None = None
+    start: object = None
+    rounds: int = 3
+    n_search: int = 40
+    add: int = 2
+    design_options: SeatDesignOptions | None = None
+
+    def design(self, params, *, rng: np.random.Generator, progress=None):
+        from .design import DEFAULT_DESIGN, MuRoute
+        from .refine import _description, _figures, _start
+        from .routes import seat_design_from
+
+        occupants = OccupantSet(nominal=params) if self.occupants is None else self.occupants
+        if params != occupants.nominal:
+            raise ParameterError("the occupant route designs for its set's nominal seat; "
+                                 "params differ from occupants.nominal")
+        opts = (RefineOptions(mu_performance=False, occupants=occupants)
+                if self.options is None else self.options)
+        K0 = _start(MuRoute() if self.start is None else self.start, params, rng, progress)
+        weights = DEFAULT_DESIGN if self.design_options is None else self.design_options
+        d = refine_for_occupants(K0, occupants, opts, rng=rng, rounds=self.rounds,
+                                 n_search=self.n_search, add=self.add, design=weights,
+                                 progress=None if progress is None
+                                 else (lambda r: progress(_round_line(r))))
+        return seat_design_from(self.name, d.K, params=params, weights=weights,
+                                seconds=d.seconds, detail=d,
+                                description=_description(d.design),
+                                figures={**_figures(d.design), "rounds": len(d.rounds)})

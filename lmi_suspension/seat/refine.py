@@ -32,6 +32,7 @@ import logging
 import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
+from typing import ClassVar
 
 import control
 import numpy as np
@@ -44,10 +45,10 @@ from .params import SeatParameters
 from .roads import RoadInput, bump
 
 __all__ = ["BumpResponse", "TwoBlockMu", "RefineOptions", "RefineStage", "RefinedDesign",
-           "RefinedCheck", "REFINE_DELAYS", "SHIPPED_REFINED", "certify_refined",
+           "REFINE_DELAYS", "SHIPPED_REFINED", "certify_refined",
            "SHIPPED_REFINED_TRADEOFF", "frequency_response", "load_refined",
            "load_refined_tradeoff", "loop_poles", "modal_form",
-           "refine_seat_controller", "save_refined"]
+           "refine_seat_controller", "save_refined", "RefineRoute"]
 
 logger = logging.getLogger(__name__)
 
@@ -1016,88 +1017,52 @@ SHIPPED_REFINED = Path(__file__).parent / "data" / "mu_refined.json"
 SHIPPED_REFINED_TRADEOFF = Path(__file__).parent / "data" / "tradeoff_refined.json"
 
 
-@dataclass(frozen=True)
-class RefinedCheck:
-    """What a seat controller achieves against the refinement's requirements, recomputed
-    from the controller alone by routes the search did not use (:func:`certify_refined`).
-
-    Attributes
-    ----------
-    delays : tuple of float
-    peak, u_peak, x1_peak : tuple of float
-        Per delay, from the exact-delay time simulation of the linear loop (no
-        clipping: the requirements bound what the controller commands; where that
-        stays within the actuator's 1500 N, the clipping never acts and this is the
-        loop ``reproduce`` simulates): peak ``|z̈3|`` (m/s²), largest commanded ``|u|``
-        (N), peak ``|x1|`` (m).
-    sampled_peak : tuple of float
-        Peak ``|z̈3|`` of the 1 kHz sampled-data loop (Tustin, zero-order hold), also
-        unclipped.
-    mu : ConstrainedCheck
-        µ bounds on the dense grid (:func:`~.constrained.certify_constrained`), worst
-        cases over the bump's energy and pole magnitudes.
-    delay_margin : float
-        Smallest destabilising delay of the linear loop, s.
-    """
-
-    delays: tuple
-    peak: tuple
-    u_peak: tuple
-    x1_peak: tuple
-    sampled_peak: tuple
-    mu: object
-    delay_margin: float
-
-
 def certify_refined(K, *, Kd=None, delays=REFINE_DELAYS, design: SeatDesignOptions | None = None,
                     params: SeatParameters | None = None,
-                    rng: np.random.Generator | None = None) -> RefinedCheck:
-    """Certify a seat controller: the bump at each delay by time simulation (not the
-    search's FFT), µ upper and lower bounds by :func:`~lmi_suspension.mu.mussv` on a
-    dense grid (not the search's two-block formula), the 1 kHz sampled-data loop and
-    the delay margin.
+                    rng: np.random.Generator | None = None):
+    """Certify a seat controller against the refinement's requirements: the bump at each
+    delay by time simulation (not the search's FFT), µ upper and lower bounds by
+    :func:`~lmi_suspension.mu.mussv` on a dense grid (not the search's two-block
+    formula), the 1 kHz sampled-data loop and the delay margin.
 
-    Parameters
-    ----------
-    K : control.StateSpace
-    Kd : control.StateSpace, optional
-        Its discrete realization (Tustin at 1 kHz by default).
-    delays : sequence of float
-    design : SeatDesignOptions, optional
-        µ weights (:data:`~.design.DEFAULT_DESIGN` by default).
-    params : SeatParameters, optional
-    rng : numpy.random.Generator, optional
-        Seeds the µ lower bound.
+    The certificate of every seat route, :func:`~.routes.certify_seat`, with the
+    refinement's delays.
+
+    Returns
+    -------
+    SeatCertificate
     """
-    from .constrained import certify_constrained
-    from .design import DEFAULT_DESIGN
-    from .sampled import discretise_controller, simulate_sampled
-    from .simulate import simulate, stability_delay_margin
+    from .routes import certify_seat
 
-    Kd = discretise_controller(K) if Kd is None else Kd
-    runs = [simulate(K, bump(), delay=float(d), params=params, u_max=np.inf).metrics()
-            for d in delays]
-    peak = tuple(m.peak_z3dd for m in runs)
-    u = tuple(m.peak_u_command for m in runs)
-    x1 = tuple(m.peak_x1 for m in runs)
-    sampled = tuple(float(np.max(np.abs(simulate_sampled(Kd, bump(), delay=float(d),
-                                                          params=params,
-                                                          u_max=np.inf).z3dd)))
-                    for d in delays)
-    from ..lti import lft
-    from ..mu.steps.dgstep import resonances as _resonances
+    return certify_seat(K, Kd=Kd, delays=delays, design=design, params=params, rng=rng)
 
-    design = DEFAULT_DESIGN if design is None else design
-    aug = seat_augmented_plant(design, params)
-    omega = np.logspace(-3.0, 4.0, 300)
-    # the grid and the loop's lightly damped poles' frequencies, where a µ peak is sharp
-    _, _, at = TwoBlockMu(design, omega, params).peaks(K, 8)
-    omega = np.unique(np.concatenate([omega, at, _resonances(
-        lft(aug.P, control.ss(K.A, K.B, K.C, K.D), aug.nmeas, aug.ncon), omega)]))
-    mu = certify_constrained(K, design=design, params=params, omega=omega, rng=rng)
-    return RefinedCheck(delays=tuple(float(d) for d in delays), peak=peak, u_peak=u,
-                        x1_peak=x1, sampled_peak=sampled, mu=mu,
-                        delay_margin=float(stability_delay_margin(K, params)))
+
+def _description(d: RefinedDesign) -> str:
+    o = d.options
+    if o.plants:
+        return (f"seat controller refined to exact bump requirements at the design seat "
+                f"and {len(o.plants)} further seats: y = [x1, x3] (m) -> u (N)")
+    return ("seat controller refined from the µ design to exact bump requirements: "
+            "y = [x1, x3] (m) -> u (N)")
+
+
+def _figures(d: RefinedDesign) -> dict:
+    """What a refined design claims (the search's figures), as saved in its file."""
+    o = d.options
+    meta = {"u_bound": o.u_bound, "z_bound": o.z_bound, "mu_max": o.mu_max,
+            "disk_radius": o.disk_radius, "delays": list(o.delays),
+            "peak": d.peak.tolist(), "u_peak": d.u_peak.tolist(),
+            "x1_peak": d.x1_peak.tolist(), "mu_search_grid": d.mu, "radius": d.radius,
+            "met": d.met, "iterations": d.iterations}
+    if o.plants:
+        meta["plants"] = [asdict(p) for p in o.plants]
+    if not o.mu_performance:
+        meta["mu_performance"] = False
+    if o.occupants is not None:
+        meta["rs_sup"] = d.rs_sup
+        meta["occupants"] = {name: [lo, hi] for name, lo, hi in o.occupants.ranges()}
+        meta["occupants_delay"] = list(o.occupants.delay)
+    return meta
 
 
 def save_refined(path, d: RefinedDesign, *, dt: float = 1e-3) -> Path:
@@ -1106,28 +1071,66 @@ def save_refined(path, d: RefinedDesign, *, dt: float = 1e-3) -> Path:
     from ..io import save_controller
     from .sampled import discretise_controller
 
-    o = d.options
-    meta = {"description": "seat controller refined from the µ design to exact bump "
-                           "requirements: y = [x1, x3] (m) -> u (N)",
-            "u_bound": o.u_bound, "z_bound": o.z_bound, "mu_max": o.mu_max,
-            "disk_radius": o.disk_radius, "delays": list(o.delays),
-            "peak": d.peak.tolist(), "u_peak": d.u_peak.tolist(),
-            "x1_peak": d.x1_peak.tolist(), "mu_search_grid": d.mu, "radius": d.radius,
-            "met": d.met, "iterations": d.iterations, "design_seconds": d.seconds,
+    meta = {"description": _description(d), **_figures(d), "design_seconds": d.seconds,
             "discretisation": f"Tustin, dt = {dt} s"}
-    if o.plants:
-        meta["description"] = (f"seat controller refined to exact bump requirements at the "
-                               f"design seat and {len(o.plants)} further seats: "
-                               f"y = [x1, x3] (m) -> u (N)")
-        meta["plants"] = [asdict(p) for p in o.plants]
-    if not o.mu_performance:
-        meta["mu_performance"] = False
-    if o.occupants is not None:
-        meta["rs_sup"] = d.rs_sup
-        meta["occupants"] = {name: [lo, hi] for name, lo, hi in o.occupants.ranges()}
-        meta["occupants_delay"] = list(o.occupants.delay)
     return save_controller(path, d.K, inputs=["x1", "x3"], outputs=["u"], metadata=meta,
                            discrete=discretise_controller(d.K, dt))
+
+
+def _start(start, params, rng, progress) -> control.StateSpace:
+    """The start controller of a refinement route: given, or designed along a route."""
+    if isinstance(start, control.StateSpace):
+        return start
+    from .routes import design_seat
+
+    return design_seat(start, params=params, rng=rng, progress=progress).K
+
+
+def _stage_line(rec: RefineStage) -> str:
+    return (f"stage {rec.index}: {'accepted' if rec.accepted else 'rejected'}, peak "
+            f"{rec.peak:.3f} m/s², |u| {rec.u_peak:.0f} N, µ {rec.mu:.4f}, poles "
+            f"{rec.radius:.0f} rad/s ({rec.seconds:.0f} s)")
+
+
+@dataclass(frozen=True)
+class RefineRoute:
+    """The µ controller refined to the exact bump requirements
+    (:func:`refine_seat_controller`) as a :class:`~.routes.SeatRoute`.
+
+    Attributes
+    ----------
+    options : RefineOptions, optional
+        The requirements (the defaults of :class:`RefineOptions`).
+    start : SeatRoute or control.StateSpace, optional
+        The start controller, or the route that designs it (:class:`~.design.MuRoute`
+        by default).
+    design_options : SeatDesignOptions, optional
+        The µ weights and delay cover of the requirements
+        (:data:`~.design.DEFAULT_DESIGN` by default).
+
+    Examples
+    --------
+    >>> RefineRoute().name
+    'refined'
+    """
+
+    name: ClassVar[str] = "refined"
+    options: RefineOptions | None = None
+    start: object = None
+    design_options: SeatDesignOptions | None = None
+
+    def design(self, params: SeatParameters, *, rng: np.random.Generator, progress=None):
+        from .design import DEFAULT_DESIGN, MuRoute
+        from .routes import seat_design_from
+
+        weights = DEFAULT_DESIGN if self.design_options is None else self.design_options
+        K0 = _start(MuRoute() if self.start is None else self.start, params, rng, progress)
+        cb = None if progress is None else (lambda rec: progress(_stage_line(rec)))
+        d = refine_seat_controller(K0, self.options, design=weights, params=params,
+                                   callback=cb)
+        return seat_design_from(self.name, d.K, params=params, weights=weights,
+                                seconds=d.seconds, detail=d, description=_description(d),
+                                figures=_figures(d))
 
 
 def load_refined(path=None) -> tuple:

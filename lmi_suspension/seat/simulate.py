@@ -606,7 +606,8 @@ def stability_delay_margin(controller, params: SeatParameters | None = None, *,
     nonzero = np.abs(poles[np.abs(poles) > 0])
     w_lo = 1e-4 * (nonzero.min() if nonzero.size else 1.0)
     omega = np.geomspace(w_lo, w_hi, n_grid)
-    gain = np.log(np.abs(_freq_resp(L0, 1j * omega)))
+    with np.errstate(divide="ignore"):   # a zero loop (no controller): -inf, no crossing
+        gain = np.log(np.abs(_freq_resp(L0, 1j * omega)))
     margin = math.inf
     idx = np.nonzero(np.sign(gain[1:]) != np.sign(gain[:-1]))[0]
     def log_gain(w):

@@ -21,7 +21,7 @@ from ..seat import (
     simulate,
     white_noise,
 )
-from .spec import DESIGN, PASSIVE, PLANT_AXES, ROADS, Case
+from .spec import PASSIVE, PLANT_AXES, ROADS, Case, design_route
 
 __all__ = ["METRIC_COLUMNS", "compute_design", "compute_limit", "design_key", "error_row", "evaluate_batch",
            "evaluate_case", "limit_key"]
@@ -73,25 +73,30 @@ def compute_limit(key: tuple) -> float:
 
 
 def design_key(case: Case) -> tuple | None:
-    """What the per-case µ design of ``case`` depends on (its seat), or None where the
-    case runs a saved controller or none."""
-    if case.controller != DESIGN:
+    """What the per-case design of ``case`` depends on (its route and seat), or None where
+    the case runs a saved controller or none."""
+    route = design_route(case.controller)
+    if route is None:
         return None
-    return tuple(sorted((k, float(v)) for k, v in case.values.items() if k in PLANT_AXES))
+    return (("route", route),) + tuple(sorted((k, float(v)) for k, v in case.values.items()
+                                              if k in PLANT_AXES))
 
 
 def compute_design(key: tuple, seed: int) -> dict:
-    """The µ controller designed for the seat of a :func:`design_key`, as a saved dict (its
-    µ peak in the metadata), or ``{"error": ...}`` where the design fails."""
+    """The controller designed along the route for the seat of a :func:`design_key`, as a
+    saved dict (the route's figures in the metadata), or ``{"error": ...}`` where the
+    design fails."""
     from ..io import controller_to_dict
-    from ..seat.design import design_mu_controller
+    from ..seat.routes import design_seat
 
+    values = dict(key)
     try:
-        d = design_mu_controller(params=_params(dict(key)), rng=np.random.default_rng(seed))
+        d = design_seat(values["route"], params=_params(values),
+                        rng=np.random.default_rng(seed))
     except Exception as exc:  # the cases of this seat record it; the sweep goes on
         return {"error": f"design failed: {type(exc).__name__}: {exc}"}
     return controller_to_dict(d.K, inputs=["x1", "x3"], outputs=["u"],
-                              metadata={"mu_peak": float(d.mu_peak)})
+                              metadata=d.metadata())
 
 
 def _blank_row(case: Case) -> dict:
@@ -143,7 +148,7 @@ def evaluate_batch(cases: list, controllers: dict, road: str, settings: dict,
     from ..io import controller_from_dict
 
     built = {name: controller_from_dict(d) for name, d in controllers.items()
-             if name not in (PASSIVE, DESIGN)}
+             if name != PASSIVE and design_route(name) is None}
     built[PASSIVE] = None
     for key, d in (designs or {}).items():
         built[key] = d if "error" in d else controller_from_dict(d)
@@ -151,7 +156,8 @@ def evaluate_batch(cases: list, controllers: dict, road: str, settings: dict,
     for case in cases:
         key = limit_key(case, road, settings)
         limit = None if key is None else limits.get(key)
-        K = built[design_key(case)] if case.controller == DESIGN else built[case.controller]
+        dkey = design_key(case)
+        K = built[case.controller] if dkey is None else built[dkey]
         if isinstance(K, dict):  # a failed design
             rows.append(error_row(case, K["error"]))
             continue

@@ -34,7 +34,7 @@ from .case import (
     evaluate_batch,
     limit_key,
 )
-from .spec import DESIGN, PASSIVE, SweepSpec
+from .spec import PASSIVE, SweepSpec, design_route
 
 __all__ = ["SweepResult", "run_sweep", "read_results"]
 
@@ -110,7 +110,7 @@ def _load_controllers(spec: SweepSpec) -> dict:
 
     out = {}
     for name in spec.controllers:
-        if name in (PASSIVE, DESIGN):
+        if name == PASSIVE or design_route(name) is not None:
             out[name] = None
             continue
         path = Path(name)
@@ -295,7 +295,7 @@ def _collect(out, finished, total: int, progress, on_batch) -> float:
 
 def _used(controllers: dict, batch: list) -> dict:
     return {c.controller: controllers[c.controller] for c in batch
-            if c.controller not in (PASSIVE, DESIGN)}
+            if c.controller != PASSIVE and design_route(c.controller) is None}
 
 
 def _designs(designs: dict, batch: list) -> dict:

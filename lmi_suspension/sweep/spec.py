@@ -33,7 +33,7 @@ import numpy as np
 from ..errors import InputError, ParameterError
 from ..seat.params import SeatParameters
 
-__all__ = ["DESIGN", "PASSIVE", "PLANT_AXES", "ROADS", "SAMPLINGS", "Case", "SweepSpec",
+__all__ = ["DESIGN", "design_route", "PASSIVE", "PLANT_AXES", "ROADS", "SAMPLINGS", "Case", "SweepSpec",
            "parse_range"]
 
 #: the seat's parameters a sweep may vary (the delay bounds of SeatParameters are the
@@ -47,10 +47,27 @@ ROADS = {
 }
 #: the controller entry that means "no controller" (the passive seat)
 PASSIVE = "passive"
-#: the controller entry that means "a µ controller designed for this case's seat"
-#: (:func:`~lmi_suspension.seat.design.design_mu_controller` with the paper's weights and
-#: uncertainty, once per distinct seat of the sweep)
+#: the controller entry that means "a controller designed for this case's seat", once per
+#: distinct seat of the sweep: ``"design"`` along the µ route (the paper's weights and
+#: uncertainty), ``"design:<route>"`` along any route of
+#: :data:`~lmi_suspension.seat.routes.ROUTE_NAMES` with its default choices
 DESIGN = "design"
+
+
+def design_route(entry: str) -> str | None:
+    """The route a controller entry designs along (``"design"``: ``"mu"``), or None for a
+    controller file or ``"passive"``.
+
+    Examples
+    --------
+    >>> design_route("design"), design_route("design:peak_bounded"), design_route("k.json")
+    ('mu', 'peak_bounded', None)
+    """
+    if entry == DESIGN:
+        return "mu"
+    if entry.startswith(DESIGN + ":"):
+        return entry[len(DESIGN) + 1:]
+    return None
 #: how the Monte-Carlo values are drawn: uniformly, each case from its own generator, or
 #: as one Latin hypercube (see SweepSpec)
 SAMPLINGS = ("uniform", "lhs")
@@ -152,10 +169,11 @@ class SweepSpec:
     ----------
     controllers : tuple of str
         Saved controller files (:func:`~lmi_suspension.io.save_controller`),
-        ``"passive"`` (no controller), or ``"design"``: a µ controller synthesised for the
-        case's own seat (:func:`~lmi_suspension.seat.design.design_mu_controller`, the
-        paper's weights and uncertainty; about 10 s each, once per distinct seat); each
-        case runs one of them.
+        ``"passive"`` (no controller), ``"design"``: a µ controller synthesised for the
+        case's own seat (the µ route of :func:`~lmi_suspension.seat.routes.design_seat`,
+        the paper's weights and uncertainty; about 2 s each, once per distinct seat), or
+        ``"design:<route>"``: likewise along another route (``"design:peak_bounded"``,
+        a few seconds each); each case runs one of them.
     grid : tuple of (str, tuple of float)
         Axes of a full grid, outermost first.  Axes not named keep their default
         (Table 1, no delay, the road's defaults).
@@ -222,6 +240,14 @@ class SweepSpec:
                                  f"{', '.join(ROADS)}")
         if not self.controllers:
             raise ParameterError("controllers: at least one controller file (or 'passive')")
+        routes = {design_route(c) for c in self.controllers} - {None}
+        if routes:
+            from ..seat.routes import ROUTE_NAMES
+
+            for route in sorted(routes - set(ROUTE_NAMES)):
+                raise ParameterError(f"controllers: unknown design route {route!r} "
+                                     f"(design:<route>, the routes are "
+                                     f"{', '.join(ROUTE_NAMES)})")
         known = self.axes_known()
         seen = set()
         for name, values in self.grid:
@@ -427,7 +453,8 @@ class SweepSpec:
         ctrls = data.get("controllers", [PASSIVE])
         if isinstance(ctrls, str):
             ctrls = [ctrls]
-        ctrls = [c if c in (PASSIVE, DESIGN) or base is None or Path(c).is_absolute()
+        ctrls = [c if c == PASSIVE or design_route(c) is not None or base is None
+                 or Path(c).is_absolute()
                  else str(base / c) for c in ctrls]
         grid = tuple((str(n), parse_range(v, str(n)))
                      for n, v in dict(data.get("grid", {})).items())

@@ -375,9 +375,10 @@ class PeakBound:
 
     def peaks(self, CL) -> np.ndarray:
         A, B, C, D = _sub(CL, self.channel)
-        if np.any(D):
+        W = _gramian(A, B)
+        if np.any(D) or not np.all(np.isfinite(W)):   # a feedthrough, an unstable loop
             return np.full(C.shape[0], np.inf)
-        return np.sqrt(np.maximum(np.diag(C @ _gramian(A, B) @ C.T), 0.0))
+        return np.sqrt(np.maximum(np.diag(C @ W @ C.T), 0.0))
 
 
 @dataclass(frozen=True)

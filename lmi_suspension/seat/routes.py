@@ -1,0 +1,583 @@
+"""One entry for every seat design: routes, one result type, one certificate.
+
+The seat is designed along several routes -- µ-synthesis as in the paper
+(:class:`~.design.MuRoute`), µ-synthesis with hard force, stroke and pole bounds in every
+K-step (:class:`~.constrained.ConstrainedRoute`), the µ controller refined to the exact
+bump requirements (:class:`~.refine.RefineRoute`), that refinement over a set of
+occupants and springs (:class:`~.multimodel.OccupantRoute`) and H∞ with peak bounds by
+multi-objective LMIs (:class:`~.bounded.PeakBoundedRoute`).  Each is a small frozen
+dataclass of what a user chooses, living beside its algorithm, with a ``name`` and a
+``design`` method (the :class:`SeatRoute` protocol); :func:`design_seat` runs any of
+them and returns a :class:`SeatDesign`.  A new route is one such class in one module:
+pass an instance to :func:`design_seat`, no registration needed.
+
+Whatever the route, :func:`certify_seat` checks the controller by computations the
+routes do not use to produce it (time simulation of the exact-delay loop, the 1 kHz
+sampled-data loop, µ bounds of :func:`~lmi_suspension.mu.mussv` on a dense grid,
+worst-case peaks from the closed loop's Gramian, and, given samples of a set of seats,
+stability and road figures over them and their mixed µ) and judges the figures against
+:class:`SeatRequirements` (issue 38's targets by default).  :func:`save_seat_design`
+and :func:`load_seat_design` write and read any design as a controller file
+(``controller.json``'s format), so that ``reproduce``, the CLI, the sweep and a user's
+script treat every route alike.
+
+Examples
+--------
+>>> from lmi_suspension.seat.routes import design_seat, route_named
+>>> d = design_seat(route_named("peak_bounded"))
+>>> d.route, d.K.ninputs, d.K.noutputs, d.Kd.dt
+('peak_bounded', 2, 1, 0.001)
+>>> bool(d.figures["u_peak"] <= 1500.0 * 1.005)
+True
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from types import MappingProxyType
+from typing import Callable, ClassVar, Mapping, Protocol, runtime_checkable
+
+import control
+import numpy as np
+
+from ..errors import InputError, ParameterError
+from .augmented import SeatDesignOptions
+from .constrained import SHIPPED_CONTROLLER
+from .multimodel import SHIPPED_OCCUPANTS
+from .params import SeatParameters
+from .refine import SHIPPED_REFINED
+
+__all__ = ["SeatRoute", "SeatDesign", "SeatRequirements", "SeatCertificate", "ROUTE_NAMES",
+           "SHIPPED_DESIGNS", "route_named", "design_seat", "certify_seat",
+           "save_seat_design", "load_seat_design", "seat_design_from"]
+
+logger = logging.getLogger(__name__)
+
+#: the delays a certificate meets the bump at, s (issue 38's 0, 5, ..., 25 ms)
+CERTIFY_DELAYS = (0.0, 0.005, 0.01, 0.015, 0.02, 0.025)
+
+#: the routes shipped with the package, by name (:func:`route_named`)
+ROUTE_NAMES = ("mu", "constrained", "refined", "occupants", "peak_bounded")
+
+#: the designs shipped with the package, by route name (their searches take minutes to
+#: hours; ``reproduce`` loads and re-certifies them).  The µ design is not among them:
+#: it takes about 30 s and ``reproduce`` runs it.
+SHIPPED_DESIGNS = MappingProxyType({"constrained": SHIPPED_CONTROLLER,
+                                    "refined": SHIPPED_REFINED,
+                                    "occupants": SHIPPED_OCCUPANTS})
+
+
+@runtime_checkable
+class SeatRoute(Protocol):
+    """What :func:`design_seat` runs: a frozen dataclass of the route's choices with a
+    ``name`` and a ``design`` method.
+
+    ``design(params, rng=..., progress=...)`` returns a :class:`SeatDesign` for the seat
+    ``params``; ``rng`` seeds whatever the route draws at random; ``progress``, if given,
+    is called with a line of text per iteration (a D-K iteration, a refinement stage).
+    """
+
+    name: ClassVar[str]
+
+    def design(self, params: SeatParameters, *, rng: np.random.Generator,
+               progress: Callable[[str], None] | None = None) -> "SeatDesign":
+        ...
+
+
+@dataclass(frozen=True)
+class SeatDesign:
+    """A seat controller, whatever route made it.
+
+    Attributes
+    ----------
+    route : str
+        The route's name.
+    K : control.StateSpace
+        Continuous-time controller from ``y = [x1, x3]`` (m) to ``u`` (N, sign of eq. 1),
+        inputs ``['x1', 'x3']``, output ``['u']``.
+    Kd : control.StateSpace
+        Its 1 kHz realization (Tustin, :func:`~.sampled.discretise_controller`), the one
+        a seat's controller runs.
+    params : SeatParameters
+        The seat it was designed for.
+    weights : SeatDesignOptions
+        The µ weights and delay cover the route's µ figures refer to, and
+        :meth:`certify` takes.
+    figures : Mapping
+        What the route claims of its controller, in JSON-ready values (µ bounds, worst
+        cases, whether its requirements were met, ...): the route's own figures, which
+        :func:`certify_seat` does not reuse.
+    description : str
+        One line: the route and what it asked for.
+    seconds : float
+        Wall time of the design (as saved, for a loaded design).
+    detail : object
+        The route's own result (:class:`~.design.SeatMuDesign`, ...): its history and
+        everything only that route has; None for a design read from a file.
+    """
+
+    route: str
+    K: control.StateSpace
+    Kd: control.StateSpace
+    params: SeatParameters
+    weights: SeatDesignOptions
+    figures: Mapping = field(default_factory=dict)
+    description: str = ""
+    seconds: float = 0.0
+    detail: object = field(default=None, compare=False, repr=False)
+
+    def metadata(self) -> dict:
+        """What :func:`save_seat_design` writes beside the controller: the figures, the
+        route, the description, the seat, the µ weights, the design time and the
+        discretisation."""
+        return {**self.figures, "route": self.route, "description": self.description,
+                "params": asdict(self.params), "weights": asdict(self.weights),
+                "design_seconds": self.seconds,
+                "discretisation": f"Tustin, dt = {self.Kd.dt} s"}
+
+    def certify(self, **kwargs) -> "SeatCertificate":
+        """:func:`certify_seat` of this design's controllers at its seat, with its µ
+        weights."""
+        kwargs.setdefault("params", self.params)
+        kwargs.setdefault("design", self.weights)
+        return certify_seat(self.K, Kd=self.Kd, **kwargs)
+
+
+def seat_design_from(route: str, K: control.StateSpace, *, params: SeatParameters | None,
+                     weights: SeatDesignOptions | None, figures: Mapping, description: str,
+                     seconds: float, detail=None,
+                     Kd: control.StateSpace | None = None) -> SeatDesign:
+    """A :class:`SeatDesign` with the controller named as the seat's and its 1 kHz
+    realization (a route's ``design`` ends with it)."""
+    from .sampled import discretise_controller
+
+    K = control.ss(K.A, K.B, K.C, K.D, inputs=["x1", "x3"], outputs=["u"],
+                   name=f"K_{route}")
+    if Kd is None:
+        # a pole above the 1 kHz Nyquist rate is a fact about the design, which the
+        # certificate judges (SeatRequirements.pole_radius) and reproduce reports; a
+        # design made, not a discretisation gone wrong, so no warning here
+        Kd = discretise_controller(K, warn_unresolved=False)
+    return SeatDesign(route=route, K=K, Kd=Kd,
+                      params=SeatParameters() if params is None else params,
+                      weights=_default_weights(route) if weights is None else weights,
+                      figures=_jsonable(dict(figures)), description=description,
+                      seconds=float(seconds), detail=detail)
+
+
+def route_named(name: str) -> SeatRoute:
+    """The route ``name`` of :data:`ROUTE_NAMES` with its default choices.
+
+    Raises
+    ------
+    ParameterError
+        An unknown name.
+    """
+    if name == "mu":
+        from .design import MuRoute
+        return MuRoute()
+    if name == "constrained":
+        from .constrained import ConstrainedRoute
+        return ConstrainedRoute()
+    if name == "refined":
+        from .refine import RefineRoute
+        return RefineRoute()
+    if name == "occupants":
+        from .multimodel import OccupantRoute
+        return OccupantRoute()
+    if name == "peak_bounded":
+        from .bounded import PeakBoundedRoute
+        return PeakBoundedRoute()
+    raise ParameterError(f"unknown seat design route {name!r}; the routes are "
+                         f"{', '.join(ROUTE_NAMES)}")
+
+
+def design_seat(route: SeatRoute | str = "mu", *, params: SeatParameters | None = None,
+                rng: np.random.Generator | None = None,
+                progress: Callable[[str], None] | None = None) -> SeatDesign:
+    """Design a seat controller along ``route``.
+
+    Parameters
+    ----------
+    route : SeatRoute or str
+        A route (any object of the :class:`SeatRoute` protocol) or the name of a shipped
+        one with its default choices (:data:`ROUTE_NAMES`).
+    params : SeatParameters, optional
+        The seat (Table 1 by default).
+    rng : numpy.random.Generator, optional
+        Seeds the route's random draws (``default_rng(0)`` by default).
+    progress : callable, optional
+        Called with a line of text per iteration of the route.
+
+    Returns
+    -------
+    SeatDesign
+
+    Raises
+    ------
+    ParameterError
+        ``route`` is neither a route nor a known name, ``params`` not
+        :class:`SeatParameters`, ``rng`` not a Generator.
+    InfeasibleError
+        The route's requirements cannot be met (for the routes with hard bounds).
+    """
+    route = route_named(route) if isinstance(route, str) else route
+    if not isinstance(route, SeatRoute):
+        raise ParameterError(f"route must be a SeatRoute or one of {ROUTE_NAMES}, got "
+                             f"{type(route).__name__}")
+    params = SeatParameters() if params is None else params
+    if not isinstance(params, SeatParameters):
+        raise ParameterError(f"params must be SeatParameters, got {type(params).__name__}")
+    rng = np.random.default_rng(0) if rng is None else rng
+    if not isinstance(rng, np.random.Generator):
+        raise ParameterError("rng must be a numpy.random.Generator")
+    logger.info("seat design along route %r", route.name)
+    d = route.design(params, rng=rng, progress=progress)
+    if not isinstance(d, SeatDesign) or d.route != route.name:
+        raise ParameterError(f"route {route.name!r} returned {type(d).__name__} "
+                             f"{getattr(d, 'route', '')!r}, not its own SeatDesign")
+    return d
+
+
+# ----------------------------------------------------------------------------- certificate
+
+@dataclass(frozen=True)
+class SeatRequirements:
+    """What a seat controller must achieve (issue 38's targets by default).
+
+    Attributes
+    ----------
+    u_max : float
+        Commanded ``|u|`` on the bump, N (eq. 12), unclipped, at every delay.
+    z_max : float
+        ``|x1|`` on the bump, m (eq. 13).
+    nominal_ratio : float
+        Peak ``|z̈3|`` over the seat's own physical limit, at the design seat.
+    worst_ratio : float
+        The same over a set of seats (judged where the certificate has one).
+    pole_radius : float
+        Every controller and loop pole below this magnitude, rad/s.
+    delay_max : float
+        The loop stable for every delay up to this, s (its delay margin above it).
+    sampled_tolerance : float
+        The 1 kHz sampled-data loop's peak within this fraction of the continuous one's.
+    """
+
+    u_max: float = 1500.0
+    z_max: float = 0.08
+    nominal_ratio: float = 1.3
+    worst_ratio: float = 1.5
+    pole_radius: float = 1900.0
+    delay_max: float = 0.025
+    sampled_tolerance: float = 0.01
+
+    def __post_init__(self):
+        for f in dataclasses.fields(self):
+            v = getattr(self, f.name)
+            if not (isinstance(v, (int, float)) and v > 0):
+                raise ParameterError(f"SeatRequirements.{f.name} must be positive, got {v!r}")
+
+
+@dataclass(frozen=True)
+class SeatCertificate:
+    """A seat controller's figures, recomputed from the controller alone
+    (:func:`certify_seat`).
+
+    Attributes
+    ----------
+    delays : tuple of float
+        The delays the bump is met at, s.
+    peak, u_peak, x1_peak : tuple of float
+        Per delay, from the exact-delay time simulation of the linear loop (unclipped:
+        the requirements bound what the controller commands): peak ``|z̈3|`` (m/s²),
+        largest commanded ``|u|`` (N), peak ``|x1|`` (m).
+    sampled_peak : tuple of float
+        Peak ``|z̈3|`` of the 1 kHz sampled-data loop (zero-order hold), unclipped.
+    mu : ConstrainedCheck
+        µ bounds on the dense grid (delay cover and performance,
+        :func:`~.constrained.certify_constrained`), worst-case peaks over every floor
+        velocity of the bump's energy, and pole magnitudes.
+    delay_margin : float
+        Smallest destabilising delay of the linear loop, s (0 where the loop is unstable
+        without delay).
+    loop_radius : float
+        Largest pole magnitude of the seat's loop (controller and seat, no delay), rad/s.
+    limit : float
+        The seat's own physical limit on the bump (certified peak of
+        :func:`~.limit.bump_limit`), m/s²; nan without delays.
+    occupants : OccupantCheck or None
+        Stability and road figures over the samples of a set of seats.
+    mixed_mu : MixedMuCheck or None
+        Mixed µ over that set (robust stability and performance).
+    requirements : SeatRequirements
+    """
+
+    delays: tuple
+    peak: tuple
+    u_peak: tuple
+    x1_peak: tuple
+    sampled_peak: tuple
+    mu: object
+    delay_margin: float
+    loop_radius: float
+    limit: float = math.nan
+    occupants: object = None
+    mixed_mu: object = None
+    requirements: SeatRequirements = field(default_factory=SeatRequirements)
+
+    @property
+    def nominal_ratio(self) -> float:
+        """The design seat's worst peak over its own limit over the delays."""
+        return max(self.peak) / self.limit if self.peak else math.nan
+
+    @property
+    def sampled_gap(self) -> float:
+        """The largest relative difference of the 1 kHz loop's peak from the continuous
+        loop's, over the delays."""
+        return max((abs(s - p) / p for s, p in zip(self.sampled_peak, self.peak)),
+                   default=math.nan)
+
+    def failures(self) -> tuple[str, ...]:
+        """The requirements the figures do not meet, one line each (empty: all met).
+        Only what was certified is judged: without delays the bump is not, without
+        occupant samples the set is not."""
+        r = self.requirements
+        out = []
+        if not self.delay_margin > r.delay_max:
+            out.append(f"delay margin {self.delay_margin * 1e3:.1f} ms, not above "
+                       f"{r.delay_max * 1e3:g} ms")
+        fastest = max(self.loop_radius, self.mu.controller_fastest_pole)
+        if not fastest < r.pole_radius:
+            out.append(f"poles: fastest {fastest:.0f} rad/s (controller or loop), not below "
+                       f"{r.pole_radius:g}")
+        if self.delays:
+            checks = (("commanded |u|", max(self.u_peak), r.u_max, "N"),
+                      ("|x1|", max(self.x1_peak), r.z_max, "m"),
+                      ("peak / own limit at the design seat", self.nominal_ratio,
+                       r.nominal_ratio, "×"),
+                      ("1 kHz loop's peak against the continuous one", self.sampled_gap,
+                       r.sampled_tolerance, "(relative)"))
+            for what, value, bound, unit in checks:
+                if not value <= bound:
+                    out.append(f"{what}: {value:.4g} {unit}, above {bound:g}")
+        if self.occupants is not None:
+            o = self.occupants
+            if o.unstable:
+                out.append(f"set: {o.unstable} of {o.n_stability} samples unstable")
+            for what, value, bound in (("set: worst peak / own limit", o.worst_ratio,
+                                        r.worst_ratio),
+                                       ("set: the nominal seat's peak / own limit",
+                                        o.nominal_ratio, r.nominal_ratio),
+                                       ("set: commanded |u|", o.u_max, r.u_max),
+                                       ("set: |x1|", o.x1_max, r.z_max)):
+                if not value <= bound:
+                    out.append(f"{what}: {value:.4g}, above {bound:g}")
+            if not o.loop_radius < r.pole_radius:
+                out.append(f"set: fastest loop pole {o.loop_radius:.0f} rad/s, not below "
+                           f"{r.pole_radius:g}")
+        if self.mixed_mu is not None and not self.mixed_mu.rs_sup < 1.0:
+            out.append(f"set: robust-stability mixed µ {self.mixed_mu.rs_sup:.4f}, not below 1")
+        return tuple(out)
+
+    @property
+    def met(self) -> bool:
+        """Every requirement that was certified is met."""
+        return not self.failures()
+
+
+def certify_seat(K, *, Kd=None, params: SeatParameters | None = None,
+                 delays=CERTIFY_DELAYS, design=None, occupants=None, mixed_mu: bool = False,
+                 requirements: SeatRequirements | None = None,
+                 rng: np.random.Generator | None = None,
+                 progress: Callable[[str], None] | None = None) -> SeatCertificate:
+    """Certify a seat controller by routes no design uses to produce it.
+
+    The bump at each delay by time simulation of the exact-delay loop, and of the 1 kHz
+    sampled-data loop; µ upper and lower bounds by :func:`~lmi_suspension.mu.mussv` on a
+    dense grid refined at the loop's resonances; worst-case force and stroke over every
+    floor velocity of the bump's energy (Gramian); pole magnitudes; the delay margin;
+    the seat's own physical limit (LP).  Given samples of a set of seats, stability and
+    road figures over them (:func:`~.occupants.certify_occupants`) and, with
+    ``mixed_mu``, the set's mixed µ (:func:`~.occupants.occupant_mu`).
+
+    Parameters
+    ----------
+    K : control.StateSpace
+        Continuous-time controller ``y = [x1, x3]`` (m) to ``u`` (N).
+    Kd : control.StateSpace, optional
+        Its discrete realization (Tustin at 1 kHz by default).
+    params : SeatParameters, optional
+        The design seat (Table 1 by default).
+    delays : sequence of float
+        Delays the bump is met at, s; ``()`` leaves the bump out (µ, poles and worst
+        cases only, a second or two).
+    design : SeatDesignOptions, optional
+        µ weights and delay cover (:data:`~.design.DEFAULT_DESIGN` by default).
+    occupants : OccupantSamples, optional
+        Samples of a set of seats (:func:`~.occupants.occupant_samples`).
+    mixed_mu : bool
+        Also the set's mixed µ (needs ``occupants``; about a minute).
+    requirements : SeatRequirements, optional
+    rng : numpy.random.Generator, optional
+        Seeds the µ lower bounds (``default_rng(0)`` by default): two streams spawned
+        from it, one for the seat's µ and one for the set's.
+    progress : callable, optional
+        Called with a line of text per part.
+
+    Returns
+    -------
+    SeatCertificate
+
+    Examples
+    --------
+    >>> import control
+    >>> passive = control.ss([], [], [], [[0.0, 0.0]])
+    >>> c = certify_seat(passive, delays=(0.0,))
+    >>> c.u_peak, round(c.nominal_ratio, 2), round(c.delay_margin, 1)
+    ((0.0,), 4.27, inf)
+    """
+    from ..lti import lft
+    from ..mu.steps.dgstep import resonances
+    from .augmented import seat_augmented_plant
+    from .constrained import certify_constrained
+    from .design import DEFAULT_DESIGN
+    from .limit import bump_limit
+    from .refine import _LIMIT_DT, TwoBlockMu, loop_poles
+    from .roads import bump
+    from .sampled import discretise_controller, simulate_sampled
+    from .simulate import simulate, stability_delay_margin
+
+    say = progress if progress is not None else (lambda line: None)
+    if not isinstance(K, control.StateSpace) or K.isdtime(strict=True):
+        raise ParameterError("K must be a continuous-time control.StateSpace")
+    if K.ninputs != 2 or K.noutputs != 1:
+        raise ParameterError(f"K must map y = [x1, x3] to u (2 inputs, 1 output), got "
+                             f"{K.ninputs} inputs, {K.noutputs} outputs")
+    if mixed_mu and occupants is None:
+        raise ParameterError("mixed_mu needs the set: pass occupants=occupant_samples(...)")
+    params = SeatParameters() if params is None else params
+    requirements = SeatRequirements() if requirements is None else requirements
+    rng = np.random.default_rng(0) if rng is None else rng
+    if not isinstance(rng, np.random.Generator):
+        raise ParameterError("rng must be a numpy.random.Generator")
+    # one stream per part, so that adding a part does not move another's lower bound
+    rng_mu, rng_set = rng.spawn(2)
+    design = DEFAULT_DESIGN if design is None else design
+    delays = tuple(float(d) for d in delays)
+    Kd = discretise_controller(K) if Kd is None else Kd
+    road = bump()
+    say(f"bump at {len(delays)} delays (exact-delay and 1 kHz loops)")
+    runs = [simulate(K, road, delay=d, params=params, u_max=np.inf).metrics() for d in delays]
+    sampled = tuple(float(np.max(np.abs(simulate_sampled(Kd, road, delay=d, params=params,
+                                                         u_max=np.inf).z3dd)))
+                    for d in delays)
+    say("µ bounds on a dense grid, worst cases and poles")
+    aug = seat_augmented_plant(design, params)
+    omega = np.logspace(-3.0, 4.0, 300)
+    # the grid and the loop's lightly damped poles' frequencies, where a µ peak is sharp
+    _, _, at = TwoBlockMu(design, omega, params).peaks(K, 8)
+    omega = np.unique(np.concatenate([omega, at, resonances(
+        lft(aug.P, control.ss(K.A, K.B, K.C, K.D), aug.nmeas, aug.ncon), omega)]))
+    mu = certify_constrained(K, design=design, params=params, omega=omega, rng=rng_mu)
+    limit = float(bump_limit(road, params, dt=_LIMIT_DT).certified_peak) if delays \
+        else math.nan
+    check = occ_mu = None
+    if occupants is not None:
+        from .occupants import certify_occupants, occupant_mu
+
+        say(f"the set: {len(occupants.stability)} stability and "
+            f"{len(occupants.performance)} performance samples")
+        check = certify_occupants(K, occupants, progress=progress)
+        if mixed_mu:
+            say("the set's mixed µ")
+            occ_mu = occupant_mu(K, occupants.occupants, design=design, rng=rng_set)
+    return SeatCertificate(delays=delays, peak=tuple(m.peak_z3dd for m in runs),
+                           u_peak=tuple(m.peak_u_command for m in runs),
+                           x1_peak=tuple(m.peak_x1 for m in runs), sampled_peak=sampled,
+                           mu=mu, delay_margin=float(stability_delay_margin(K, params)),
+                           loop_radius=float(np.max(np.abs(loop_poles(K, params)))),
+                           limit=limit, occupants=check, mixed_mu=occ_mu,
+                           requirements=requirements)
+
+
+# ------------------------------------------------------------------------------ files
+
+def _jsonable(obj):
+    """Plain JSON values: numpy to Python, tuples to lists, dataclasses to dicts."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return _jsonable(asdict(obj))
+    if isinstance(obj, Mapping):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple, np.ndarray)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, (np.bool_, bool)):
+        return bool(obj)
+    if isinstance(obj, (np.integer, int)):
+        return int(obj)
+    if isinstance(obj, (np.floating, float)):
+        return float(obj)
+    return obj
+
+
+def save_seat_design(path, d: SeatDesign) -> Path:
+    """Write a design as a controller file (``controller.json``'s format): both
+    realizations, the route, the seat, the figures and the description in its metadata.
+    :func:`load_seat_design` reads it back equal (``detail`` aside)."""
+    from ..io import save_controller
+
+    if not isinstance(d, SeatDesign):
+        raise ParameterError(f"d must be a SeatDesign, got {type(d).__name__}")
+    return save_controller(path, d.K, inputs=["x1", "x3"], outputs=["u"],
+                           metadata=d.metadata(), discrete=d.Kd)
+
+
+_META_KEYS = ("route", "description", "params", "weights", "design_seconds",
+              "discretisation")
+
+
+def _default_weights(route: str) -> SeatDesignOptions:
+    """The µ weights of a route's default choices (for files that do not say)."""
+    from .constrained import CONSTRAINED_DESIGN
+    from .design import DEFAULT_DESIGN
+
+    return CONSTRAINED_DESIGN if route == "constrained" else DEFAULT_DESIGN
+
+
+def load_seat_design(path_or_route, *, route: str | None = None) -> SeatDesign:
+    """Read a design: a file written by :func:`save_seat_design`, or the shipped design
+    of a route name (:data:`SHIPPED_DESIGNS`).
+
+    Files written before designs had routes (the shipped ones, ``save_refined``'s and
+    ``save_constrained``'s) carry no route: give it as ``route``, or load them by name.
+
+    Raises
+    ------
+    InputError
+        The file holds no route and none is given, or no discrete realization.
+    """
+    from ..io import load_controller, load_discrete_controller
+
+    if isinstance(path_or_route, str) and path_or_route in SHIPPED_DESIGNS:
+        route, path = path_or_route, SHIPPED_DESIGNS[path_or_route]
+    else:
+        path = Path(path_or_route)
+    K, meta = load_controller(path)
+    try:
+        Kd, _ = load_discrete_controller(path)
+    except (KeyError, InputError) as exc:
+        raise InputError(f"{path} holds no discrete realization: {exc}") from exc
+    name = meta.get("route", route)
+    if name is None:
+        raise InputError(f"{path} names no route: pass route=")
+    params = SeatParameters(**meta["params"]) if "params" in meta else SeatParameters()
+    weights = (SeatDesignOptions(**{k: tuple(v) if isinstance(v, list) else v
+                                    for k, v in meta["weights"].items()})
+               if "weights" in meta else _default_weights(str(name)))
+    return SeatDesign(route=str(name), K=K, Kd=Kd, params=params, weights=weights,
+                      figures={k: v for k, v in meta.items() if k not in _META_KEYS},
+                      description=str(meta.get("description", "")),
+                      seconds=float(meta.get("design_seconds", math.nan)))

@@ -1,0 +1,229 @@
+"""One entry for the seat's designs: routes, SeatDesign, certify_seat, the files.
+
+The routes' algorithms have their own tests (test_design, test_constrained_seat,
+test_refine, test_multimodel, test_bounded); here: that every route runs through the one
+entry alike, that the certificate recomputes the figures by its own computations, that
+a design round-trips through its file exactly, and that bad input is refused.
+"""
+
+import dataclasses
+import math
+
+import control
+import numpy as np
+import pytest
+
+from lmi_suspension.errors import InputError, ParameterError
+from lmi_suspension.io import load_controller, save_controller
+from lmi_suspension.seat import (SeatParameters, bump, bump_limit, closed_loop_stable,
+                                 seat_matrices, simulate)
+from lmi_suspension.seat.bounded import PeakBoundedRoute, design_peak_bounded
+from lmi_suspension.seat.constrained import CONSTRAINED_DESIGN, ConstrainedRoute
+from lmi_suspension.seat.design import DEFAULT_DESIGN, MuRoute
+from lmi_suspension.seat.multimodel import OccupantRoute
+from lmi_suspension.seat.occupants import OccupantSet, occupant_samples
+from lmi_suspension.seat.refine import RefineRoute, _LIMIT_DT, certify_refined
+from lmi_suspension.seat.routes import (ROUTE_NAMES, SHIPPED_DESIGNS, SeatCertificate,
+                                        SeatDesign, SeatRequirements, SeatRoute,
+                                        certify_seat, design_seat, load_seat_design,
+                                        route_named, save_seat_design, seat_design_from)
+from lmi_suspension.seat.sampled import discretise_controller
+
+PASSIVE = control.ss([], [], [], [[0.0, 0.0]])
+
+
+@pytest.fixture(scope="module")
+def peak_bounded():
+    """The fast route (an LMI, a few seconds) through the one entry."""
+    return design_seat("peak_bounded", rng=np.random.default_rng(0))
+
+
+def test_every_route_name_gives_its_route():
+    for name in ROUTE_NAMES:
+        route = route_named(name)
+        assert isinstance(route, SeatRoute) and route.name == name
+    assert {type(route_named(n)) for n in ROUTE_NAMES} == {
+        MuRoute, ConstrainedRoute, RefineRoute, OccupantRoute, PeakBoundedRoute}
+
+
+def test_a_route_design_is_the_routes_own_controller_named_and_discretised(peak_bounded):
+    d = peak_bounded
+    assert isinstance(d, SeatDesign) and d.route == "peak_bounded"
+    assert d.K.input_labels == ["x1", "x3"] and d.K.output_labels == ["u"]
+    # the route's own function, called directly, gives the same controller
+    direct = design_peak_bounded(1500.0, 0.08)
+    for a, b in zip((d.K.A, d.K.B, d.K.C, d.K.D), (direct.K.A, direct.K.B, direct.K.C,
+                                                   direct.K.D)):
+        np.testing.assert_allclose(a, b, rtol=1e-6, atol=1e-9 * np.max(np.abs(b)))
+    Kd = discretise_controller(d.K)
+    assert d.Kd.dt == 1e-3 and np.array_equal(d.Kd.A, Kd.A) and np.array_equal(d.Kd.B, Kd.B)
+    assert d.figures["u_peak"] == pytest.approx(direct.u_peak, rel=1e-6)
+    assert d.weights == DEFAULT_DESIGN and isinstance(d.detail, type(direct))
+
+
+def test_the_certificate_bounds_the_bump_by_the_routes_own_guarantee(peak_bounded):
+    """The route guarantees |u| <= u_peak and |x1| <= x1_peak for every floor velocity of
+    the bump's energy (its Gramian); the certificate's time simulation of the bump itself
+    (no delay, the loop the route designed for) must stay below both."""
+    c = peak_bounded.certify(delays=(0.0,))
+    assert isinstance(c, SeatCertificate)
+    assert c.u_peak[0] <= peak_bounded.figures["u_peak"] * (1 + 1e-9)
+    assert c.x1_peak[0] <= peak_bounded.figures["x1_peak"] * (1 + 1e-9)
+    # the certificate's own figures, recomputed here by the simulator and the LP
+    m = simulate(peak_bounded.K, bump(), delay=0.0, u_max=np.inf).metrics()
+    assert c.peak[0] == m.peak_z3dd and c.u_peak[0] == m.peak_u_command
+    assert c.limit == pytest.approx(bump_limit(bump(), dt=_LIMIT_DT).certified_peak,
+                                    rel=1e-12)
+    assert c.nominal_ratio == pytest.approx(m.peak_z3dd / c.limit, rel=1e-12)
+    # µ bounds of a certificate: lower <= upper, and poles counted on the loop
+    assert c.mu.mu_lower_peak <= c.mu.mu_upper.max() * (1 + 1e-6)
+    assert c.mu.controller_fastest_pole == pytest.approx(
+        np.max(np.abs(np.linalg.eigvals(peak_bounded.K.A))), rel=1e-9)
+
+
+def test_the_passive_seat_is_judged_against_the_requirements():
+    """The passive seat: no force, its bump peak 4.3 × the limit (the limit is a lower
+    bound for every force history, the passive one's included)."""
+    c = certify_seat(PASSIVE, delays=(0.0, 0.025))
+    assert c.u_peak == (0.0, 0.0) and math.isinf(c.delay_margin)
+    # no controller: the loop's poles are the seat's own (Table 1's model)
+    assert c.loop_radius == pytest.approx(
+        np.max(np.abs(np.linalg.eigvals(seat_matrices().A))), rel=1e-9)
+    assert 1.0 <= c.nominal_ratio
+    failures = c.failures()
+    assert len(failures) == 1 and "own limit" in failures[0] and not c.met
+    # the same figures, judged against looser requirements: met
+    loose = certify_seat(PASSIVE, delays=(0.0, 0.025),
+                         requirements=SeatRequirements(nominal_ratio=c.nominal_ratio * 1.01))
+    assert loose.met and loose.peak == c.peak
+    # without delays, the bump is not judged (and no limit is computed)
+    bare = certify_seat(PASSIVE, delays=())
+    assert bare.delays == () and math.isnan(bare.limit) and bare.met
+    # a negative spring softer than k1 (31 kN/m) removed: unstable without delay, which
+    # the certificate says whatever else it measures
+    soft = control.ss([], [], [], [[-40000.0, 0.0]])
+    assert not closed_loop_stable(soft, 0.0)
+    unstable = certify_seat(soft, delays=())
+    assert unstable.delay_margin == 0.0 and math.isinf(unstable.mu.u_peak)
+    assert any(f.startswith("delay margin") for f in unstable.failures())
+
+
+def test_certify_refined_is_the_one_certificate_with_the_refinements_delays():
+    from lmi_suspension.seat.refine import REFINE_DELAYS
+
+    K = control.ss([[-200.0]], [[200.0, 0.0]], [[15000.0]], [[0.0, 2000.0]])
+    a = certify_refined(K, rng=np.random.default_rng(0))
+    b = certify_seat(K, delays=REFINE_DELAYS, rng=np.random.default_rng(0))
+    assert isinstance(a, SeatCertificate) and a.delays == REFINE_DELAYS
+    assert a.peak == b.peak and a.sampled_peak == b.sampled_peak
+    assert a.mu.mu_peak == b.mu.mu_peak
+
+
+def test_a_design_round_trips_through_its_file_exactly(peak_bounded, tmp_path):
+    path = save_seat_design(tmp_path / "d.json", peak_bounded)
+    e = load_seat_design(path)
+    for name in ("A", "B", "C", "D"):
+        assert np.array_equal(getattr(e.K, name), getattr(peak_bounded.K, name))
+        assert np.array_equal(getattr(e.Kd, name), getattr(peak_bounded.Kd, name))
+    assert e.Kd.dt == peak_bounded.Kd.dt
+    # every field but the route's in-memory result
+    for f in dataclasses.fields(SeatDesign):
+        if f.name not in ("K", "Kd", "detail"):
+            assert getattr(e, f.name) == getattr(peak_bounded, f.name), f.name
+    # a seat and weights that are not the defaults survive too
+    other = dataclasses.replace(peak_bounded, params=SeatParameters(m3=61.5),
+                                weights=CONSTRAINED_DESIGN)
+    e2 = load_seat_design(save_seat_design(tmp_path / "o.json", other))
+    assert e2.params == other.params and e2.weights == CONSTRAINED_DESIGN
+
+
+def test_shipped_designs_load_by_name_with_their_weights():
+    for name, path in SHIPPED_DESIGNS.items():
+        d = load_seat_design(name)
+        K, meta = load_controller(path)
+        assert d.route == name and np.array_equal(d.K.A, K.A) and d.Kd.dt == 1e-3
+        assert d.description == meta["description"]
+        assert d.weights == (CONSTRAINED_DESIGN if name == "constrained" else DEFAULT_DESIGN)
+
+
+def test_a_file_without_a_route_needs_one(tmp_path, peak_bounded):
+    path = save_controller(tmp_path / "k.json", peak_bounded.K, discrete=peak_bounded.Kd)
+    with pytest.raises(InputError, match="route"):
+        load_seat_design(path)
+    assert load_seat_design(path, route="peak_bounded").route == "peak_bounded"
+    bare = save_controller(tmp_path / "c.json", peak_bounded.K)
+    with pytest.raises(InputError, match="discrete"):
+        load_seat_design(bare, route="peak_bounded")
+
+
+@dataclasses.dataclass(frozen=True)
+class _StaticRoute:
+    """A user's route in a few lines: a static gain on the seat deflection."""
+
+    name = "static"
+    gain: float = 2000.0
+
+    def design(self, params, *, rng, progress=None):
+        if progress is not None:
+            progress("static gain")
+        K = control.ss([], [], [], [[self.gain, 0.0]])
+        return seat_design_from(self.name, K, params=params, weights=None,
+                                figures={"gain": self.gain}, description="static gain",
+                                seconds=0.0)
+
+
+def test_a_users_route_is_one_class_passed_to_the_entry(tmp_path):
+    lines = []
+    d = design_seat(_StaticRoute(), params=SeatParameters(m3=50.0), progress=lines.append)
+    assert d.route == "static" and lines == ["static gain"]
+    assert d.params.m3 == 50.0 and d.K.D[0, 0] == 2000.0
+    e = load_seat_design(save_seat_design(tmp_path / "s.json", d))
+    assert e.route == "static" and e.figures == {"gain": 2000.0}
+
+
+def test_bad_input_is_refused_with_typed_errors():
+    with pytest.raises(ParameterError, match="unknown seat design route"):
+        design_seat("nope")
+    with pytest.raises(ParameterError, match="SeatRoute"):
+        design_seat(object())
+    with pytest.raises(ParameterError, match="params"):
+        design_seat(_StaticRoute(), params={"m3": 50.0})
+    with pytest.raises(ParameterError, match="rng"):
+        design_seat(_StaticRoute(), rng=42)
+
+    @dataclasses.dataclass(frozen=True)
+    class Liar:
+        name = "liar"
+
+        def design(self, params, *, rng, progress=None):   # another route's design
+            return _StaticRoute().design(params, rng=rng)
+
+    with pytest.raises(ParameterError, match="not its own"):
+        design_seat(Liar())
+    with pytest.raises(ParameterError, match="continuous"):
+        certify_seat(discretise_controller(control.ss([[-1.0]], [[1.0, 0.0]], [[1.0]],
+                                                      [[0.0, 0.0]])))
+    with pytest.raises(ParameterError, match="2 inputs"):
+        certify_seat(control.ss([], [], [], [[1.0]]))
+    with pytest.raises(ParameterError, match="occupants"):
+        certify_seat(PASSIVE, delays=(), mixed_mu=True)
+    with pytest.raises(ParameterError, match="u_max"):
+        SeatRequirements(u_max=-1.0)
+    with pytest.raises(ParameterError, match="SeatDesign"):
+        save_seat_design("x.json", object())
+    with pytest.raises(ParameterError, match="nominal"):
+        OccupantRoute(occupants=OccupantSet()).design(SeatParameters(m3=50.0),
+                                                      rng=np.random.default_rng(0))
+
+
+def test_the_set_is_certified_and_judged_when_samples_are_given(peak_bounded):
+    """A few samples of the set (the occupant figures have their own tests): the
+    certificate carries them and judges the set's worst ratio and force."""
+    S = occupant_samples(rng=np.random.default_rng(1), n_stability=20, n_performance=2)
+    c = peak_bounded.certify(delays=(0.0,), occupants=S)
+    o = c.occupants
+    assert o is not None and o.n_stability == 20 and o.ratio.shape[0] == 2
+    failures = c.failures()
+    assert any(f.startswith("set: worst peak / own limit") for f in failures) == (
+        o.worst_ratio > c.requirements.worst_ratio)
+    assert c.mixed_mu is None
