@@ -1,6 +1,5 @@
-"""Command line: ``lmi-suspension model | reproduce | simulate | sweep | design-constrained |
-refine | tradeoff |
-export``."""
+"""Command line: ``lmi-suspension model | reproduce | simulate | sweep | design |
+design-constrained | refine | occupants | tradeoff | export``."""
 
 from __future__ import annotations
 
@@ -570,7 +569,8 @@ def build_parser() -> argparse.ArgumentParser:
         "controller; run on a local Dask cluster or on --scheduler. Re-running into the "
         "same --out skips the finished cases.")
     p_sw.add_argument("--controller", action="append", default=None,
-                      help="controller JSON (repeatable; 'passive' for none)")
+                      help="controller JSON (repeatable; 'passive' for none; 'design' or "
+                           "'design:ROUTE' for one designed per seat, see 'design')")
     p_sw.add_argument("--m3", default=None, help="upper-body mass, kg (e.g. 30:70:9)")
     p_sw.add_argument("--delay", default=None, help="actuator delay, s (e.g. 0:0.05:11)")
     p_sw.add_argument("--param", action="append", default=None, metavar="NAME=RANGE",

@@ -81,6 +81,37 @@ def test_the_certificate_bounds_the_bump_by_the_routes_own_guarantee(peak_bounde
         np.max(np.abs(np.linalg.eigvals(peak_bounded.K.A))), rel=1e-9)
 
 
+def test_the_mu_route_through_the_entry_is_the_paper_design():
+    """The µ route (seconds) through design_seat: the controller of design_mu_controller
+    called directly with the same seed, bit for bit, and its figures."""
+    from lmi_suspension.seat.design import design_mu_controller
+
+    lines = []
+    d = design_seat("mu", rng=np.random.default_rng(3), progress=lines.append)
+    direct = design_mu_controller(rng=np.random.default_rng(3))
+    assert all(np.array_equal(getattr(d.K, m), getattr(direct.K, m)) for m in "ABCD")
+    assert d.figures["mu_peak_upper"] == direct.mu_peak and d.weights == DEFAULT_DESIGN
+    assert len(lines) == len(direct.musyn.history) and lines[0].startswith("D-K iteration 1:")
+
+
+def test_a_nan_figure_is_a_failure_not_a_pass():
+    """``max`` drops a nan that does not come first; the judgement must not."""
+    base = certify_seat(PASSIVE, delays=(0.0, 0.025))
+    nan = math.nan
+    for field, value in (("u_peak", (0.0, nan)), ("x1_peak", (0.03, nan)),
+                         ("peak", (base.peak[0], nan)),
+                         ("sampled_peak", (base.sampled_peak[0], nan))):
+        bad = dataclasses.replace(base, **{field: value},
+                                  requirements=SeatRequirements(nominal_ratio=100.0))
+        assert bad.failures(), field
+    bad = dataclasses.replace(base, loop_radius=nan)
+    assert any(f.startswith("poles") for f in bad.failures())
+    # the boundaries: |u| at the bound passes, a pole at the radius does not
+    edge = dataclasses.replace(base, u_peak=(1500.0, 0.0), loop_radius=1900.0,
+                               requirements=SeatRequirements(nominal_ratio=100.0))
+    assert [f.split(":")[0] for f in edge.failures()] == ["poles"]
+
+
 def test_the_passive_seat_is_judged_against_the_requirements():
     """The passive seat: no force, its bump peak 4.3 × the limit (the limit is a lower
     bound for every force history, the passive one's included)."""
@@ -154,6 +185,12 @@ def test_a_file_without_a_route_needs_one(tmp_path, peak_bounded):
     bare = save_controller(tmp_path / "c.json", peak_bounded.K)
     with pytest.raises(InputError, match="discrete"):
         load_seat_design(bare, route="peak_bounded")
+    # a file's own route is not overridden, and a route without a shipped design says so
+    saved = save_seat_design(tmp_path / "d.json", peak_bounded)
+    with pytest.raises(InputError, match="not 'refined'"):
+        load_seat_design(saved, route="refined")
+    with pytest.raises(InputError, match="no shipped design"):
+        load_seat_design("mu")
 
 
 @dataclasses.dataclass(frozen=True)
@@ -207,8 +244,9 @@ def test_bad_input_is_refused_with_typed_errors():
         certify_seat(control.ss([], [], [], [[1.0]]))
     with pytest.raises(ParameterError, match="occupants"):
         certify_seat(PASSIVE, delays=(), mixed_mu=True)
-    with pytest.raises(ParameterError, match="u_max"):
-        SeatRequirements(u_max=-1.0)
+    for bad in (-1.0, True, math.nan):
+        with pytest.raises(ParameterError, match="u_max"):
+            SeatRequirements(u_max=bad)
     with pytest.raises(ParameterError, match="SeatDesign"):
         save_seat_design("x.json", object())
     with pytest.raises(ParameterError, match="nominal"):

@@ -907,8 +907,10 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                "design_seconds": getattr(mu_design, "seconds", None)},
         "design_options": metadata["design_options"],
         "musyn_options": metadata["musyn_options"],
-        **{name: None if loaded is None else {"check": loaded[1],
-                                               "design": loaded[0].metadata()}
+        **{name: None if loaded is None else {
+            "check": loaded[1], "design": loaded[0].metadata(),
+            # judged without the bump (simulated above with every controller)
+            "requirements_not_met": list(loaded[1].failures())}
            for name, loaded in (("mu_constrained", constrained), ("mu_refined", refined),
                                 ("mu_occupants", occupants))},
         "exported": exported,

@@ -208,6 +208,8 @@ class PeakBoundedRoute:
     z_max: float = 0.08
 
     def design(self, params: SeatParameters, *, rng=None, progress=None):
+        """:func:`design_peak_bounded` at ``params`` (nothing random, no iterations to
+        report), as a :class:`~.routes.SeatDesign`."""
         import time
 
         from .routes import seat_design_from

@@ -353,6 +353,7 @@ class ConstrainedRoute:
     musyn_options: MusynOptions | None = None
 
     def design(self, params: SeatParameters, *, rng: np.random.Generator, progress=None):
+        """:func:`design_constrained_mu` at ``params``, as a :class:`~.routes.SeatDesign`."""
         from .design import _dk_line
         from .routes import seat_design_from
 

@@ -48,8 +48,9 @@ from ..mu import MusynOptions, MusynResult, musyn
 from .augmented import SeatAugmentedPlant, SeatDesignOptions, seat_augmented_plant
 from .params import SeatParameters
 
-__all__ = ["DEFAULT_DESIGN", "DEFAULT_MUSYN", "DEFAULT_OMEGA", "MuCheck", "MuRoute", "SeatMuDesign",
-           "analyse_uncertainty", "design_mu_controller", "design_nominal_hinf"]
+__all__ = ["DEFAULT_DESIGN", "DEFAULT_MUSYN", "DEFAULT_OMEGA", "MuCheck", "MuRoute",
+           "SeatMuDesign", "analyse_uncertainty", "design_mu_controller",
+           "design_nominal_hinf"]
 
 logger = logging.getLogger(__name__)
 
@@ -301,8 +302,9 @@ def analyse_uncertainty(K: control.StateSpace, design: SeatDesignOptions | None 
 def _dk_line(rec) -> str:
     """One line of progress for a D-K record (an iteration, or a D-scale search record)."""
     what = "D-K iteration" if rec.stage == "dk" else "D-scale search, record"
+    seconds = rec.seconds_k + rec.seconds_d + rec.seconds_fit
     return (f"{what} {rec.index}: gamma {rec.gamma:.4f}, µ upper {rec.mu_peak:.4f}, "
-            f"lower {rec.mu_lower_peak:.4f} ({rec.seconds_k + rec.seconds_d + rec.seconds_fit:.1f} s)")
+            f"lower {rec.mu_lower_peak:.4f} ({seconds:.1f} s)")
 
 
 @dataclass(frozen=True)
@@ -321,6 +323,7 @@ class MuRoute:
     musyn_options: MusynOptions | None = None
 
     def design(self, params: SeatParameters, *, rng: np.random.Generator, progress=None):
+        """:func:`design_mu_controller` at ``params``, as a :class:`~.routes.SeatDesign`."""
         from .routes import seat_design_from
 
         cb = None if progress is None else (lambda rec: progress(_dk_line(rec)))
@@ -328,8 +331,8 @@ class MuRoute:
                                  musyn_options=self.musyn_options, callback=cb, rng=rng)
         return seat_design_from(
             self.name, d.K, params=params, weights=d.aug.options, seconds=d.seconds,
-            detail=d, description="µ-synthesis seat controller (D-K iteration, delay cover "
-                        "0–25 ms): y = [x1, x3] (m) -> u (N)",
+            detail=d, description="µ-synthesis seat controller (D-K iteration): "
+                                  "y = [x1, x3] (m) -> u (N)",
             figures={"mu_peak_upper": d.mu_peak, "mu_peak_lower": d.mu_lower_peak,
                      "stop_reason": d.musyn.stop_reason})
 

@@ -214,6 +214,7 @@ def refine_for_occupants(K0, occupants: OccupantSet | None = None,
 
 
 def _round_line(r: OccupantRound) -> str:
+    """One line of progress for a round."""
     return (f"round {r.index}: {len(r.plants) + 1} seats, worst peak/limit "
             f"{np.max(r.design.peak):.3f}, |u| {np.max(r.design.u_peak):.0f} N, met "
             f"{r.design.met}; search: worst {r.worst_found:.3f}, {r.violations_found} "
@@ -259,6 +260,8 @@ class OccupantRoute:
     design_options: SeatDesignOptions | None = None
 
     def design(self, params, *, rng: np.random.Generator, progress=None):
+        """The start (given or designed), refined for the set around ``params``; two
+        streams spawned from ``rng``: the start's route's and the worst-case search's."""
         from .design import DEFAULT_DESIGN, MuRoute
         from .refine import _description, _figures, _start
         from .routes import seat_design_from
@@ -269,9 +272,13 @@ class OccupantRoute:
                                  "params differ from occupants.nominal")
         opts = (RefineOptions(mu_performance=False, occupants=occupants)
                 if self.options is None else self.options)
-        K0 = _start(MuRoute() if self.start is None else self.start, params, rng, progress)
+        # one stream each: the start's draws do not move the search's samples
+        rng_start, rng_search = rng.spawn(2)
+        start = (MuRoute(design_options=self.design_options) if self.start is None
+                 else self.start)
+        K0 = _start(start, params, rng_start, progress)
         weights = DEFAULT_DESIGN if self.design_options is None else self.design_options
-        d = refine_for_occupants(K0, occupants, opts, rng=rng, rounds=self.rounds,
+        d = refine_for_occupants(K0, occupants, opts, rng=rng_search, rounds=self.rounds,
                                  n_search=self.n_search, add=self.add, design=weights,
                                  progress=None if progress is None
                                  else (lambda r: progress(_round_line(r))))

@@ -1028,6 +1028,18 @@ def certify_refined(K, *, Kd=None, delays=REFINE_DELAYS, design: SeatDesignOptio
     The certificate of every seat route, :func:`~.routes.certify_seat`, with the
     refinement's delays.
 
+    Parameters
+    ----------
+    K : control.StateSpace
+    Kd : control.StateSpace, optional
+        Its discrete realization (Tustin at 1 kHz by default).
+    delays : sequence of float
+    design : SeatDesignOptions, optional
+        µ weights (:data:`~.design.DEFAULT_DESIGN` by default).
+    params : SeatParameters, optional
+    rng : numpy.random.Generator, optional
+        Seeds the µ lower bound.
+
     Returns
     -------
     SeatCertificate
@@ -1038,6 +1050,7 @@ def certify_refined(K, *, Kd=None, delays=REFINE_DELAYS, design: SeatDesignOptio
 
 
 def _description(d: RefinedDesign) -> str:
+    """What a refined design is, in one line (its file's description)."""
     o = d.options
     if o.plants:
         return (f"seat controller refined to exact bump requirements at the design seat "
@@ -1087,6 +1100,7 @@ def _start(start, params, rng, progress) -> control.StateSpace:
 
 
 def _stage_line(rec: RefineStage) -> str:
+    """One line of progress for a refinement stage."""
     return (f"stage {rec.index}: {'accepted' if rec.accepted else 'rejected'}, peak "
             f"{rec.peak:.3f} m/s², |u| {rec.u_peak:.0f} N, µ {rec.mu:.4f}, poles "
             f"{rec.radius:.0f} rad/s ({rec.seconds:.0f} s)")
@@ -1103,7 +1117,7 @@ class RefineRoute:
         The requirements (the defaults of :class:`RefineOptions`).
     start : SeatRoute or control.StateSpace, optional
         The start controller, or the route that designs it (:class:`~.design.MuRoute`
-        by default).
+        with ``design_options`` by default).
     design_options : SeatDesignOptions, optional
         The µ weights and delay cover of the requirements
         (:data:`~.design.DEFAULT_DESIGN` by default).
@@ -1120,11 +1134,14 @@ class RefineRoute:
     design_options: SeatDesignOptions | None = None
 
     def design(self, params: SeatParameters, *, rng: np.random.Generator, progress=None):
+        """The start (given or designed), refined at ``params``; the search draws
+        nothing at random, so ``rng`` reaches the start's route alone."""
         from .design import DEFAULT_DESIGN, MuRoute
         from .routes import seat_design_from
 
         weights = DEFAULT_DESIGN if self.design_options is None else self.design_options
-        K0 = _start(MuRoute() if self.start is None else self.start, params, rng, progress)
+        start = MuRoute(design_options=weights) if self.start is None else self.start
+        K0 = _start(start, params, rng, progress)
         cb = None if progress is None else (lambda rec: progress(_stage_line(rec)))
         d = refine_seat_controller(K0, self.options, design=weights, params=params,
                                    callback=cb)

@@ -49,7 +49,7 @@ from .augmented import SeatDesignOptions
 from .constrained import SHIPPED_CONTROLLER
 from .multimodel import SHIPPED_OCCUPANTS
 from .params import SeatParameters
-from .refine import SHIPPED_REFINED
+from .refine import REFINE_DELAYS, SHIPPED_REFINED
 
 __all__ = ["SeatRoute", "SeatDesign", "SeatRequirements", "SeatCertificate", "ROUTE_NAMES",
            "SHIPPED_DESIGNS", "route_named", "design_seat", "certify_seat",
@@ -57,15 +57,12 @@ __all__ = ["SeatRoute", "SeatDesign", "SeatRequirements", "SeatCertificate", "RO
 
 logger = logging.getLogger(__name__)
 
-#: the delays a certificate meets the bump at, s (issue 38's 0, 5, ..., 25 ms)
-CERTIFY_DELAYS = (0.0, 0.005, 0.01, 0.015, 0.02, 0.025)
-
 #: the routes shipped with the package, by name (:func:`route_named`)
 ROUTE_NAMES = ("mu", "constrained", "refined", "occupants", "peak_bounded")
 
 #: the designs shipped with the package, by route name (their searches take minutes to
 #: hours; ``reproduce`` loads and re-certifies them).  The µ design is not among them:
-#: it takes about 30 s and ``reproduce`` runs it.
+#: it takes seconds and ``reproduce`` runs it.
 SHIPPED_DESIGNS = MappingProxyType({"constrained": SHIPPED_CONTROLLER,
                                     "refined": SHIPPED_REFINED,
                                     "occupants": SHIPPED_OCCUPANTS})
@@ -88,7 +85,7 @@ class SeatRoute(Protocol):
         ...
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class SeatDesign:
     """A seat controller, whatever route made it.
 
@@ -118,6 +115,10 @@ class SeatDesign:
     detail : object
         The route's own result (:class:`~.design.SeatMuDesign`, ...): its history and
         everything only that route has; None for a design read from a file.
+
+    Two designs are equal only if they are the same object (python-control's
+    ``StateSpace`` has no value equality); compare a saved and a loaded one field by
+    field.
     """
 
     route: str
@@ -278,7 +279,7 @@ class SeatRequirements:
     def __post_init__(self):
         for f in dataclasses.fields(self):
             v = getattr(self, f.name)
-            if not (isinstance(v, (int, float)) and v > 0):
+            if isinstance(v, bool) or not (isinstance(v, (int, float)) and v > 0):
                 raise ParameterError(f"SeatRequirements.{f.name} must be positive, got {v!r}")
 
 
@@ -331,15 +332,18 @@ class SeatCertificate:
 
     @property
     def nominal_ratio(self) -> float:
-        """The design seat's worst peak over its own limit over the delays."""
-        return max(self.peak) / self.limit if self.peak else math.nan
+        """The design seat's worst peak over its own limit over the delays (a nan
+        anywhere stays nan: ``np.max``, not ``max``, which would drop it)."""
+        return float(np.max(self.peak)) / self.limit if self.peak else math.nan
 
     @property
     def sampled_gap(self) -> float:
         """The largest relative difference of the 1 kHz loop's peak from the continuous
         loop's, over the delays."""
-        return max((abs(s - p) / p for s, p in zip(self.sampled_peak, self.peak)),
-                   default=math.nan)
+        if not self.peak:
+            return math.nan
+        s, p = np.asarray(self.sampled_peak, float), np.asarray(self.peak, float)
+        return float(np.max(np.abs(s - p) / p))
 
     def failures(self) -> tuple[str, ...]:
         """The requirements the figures do not meet, one line each (empty: all met).
@@ -350,13 +354,13 @@ class SeatCertificate:
         if not self.delay_margin > r.delay_max:
             out.append(f"delay margin {self.delay_margin * 1e3:.1f} ms, not above "
                        f"{r.delay_max * 1e3:g} ms")
-        fastest = max(self.loop_radius, self.mu.controller_fastest_pole)
+        fastest = float(np.max([self.loop_radius, self.mu.controller_fastest_pole]))
         if not fastest < r.pole_radius:
             out.append(f"poles: fastest {fastest:.0f} rad/s (controller or loop), not below "
                        f"{r.pole_radius:g}")
         if self.delays:
-            checks = (("commanded |u|", max(self.u_peak), r.u_max, "N"),
-                      ("|x1|", max(self.x1_peak), r.z_max, "m"),
+            checks = (("commanded |u|", float(np.max(self.u_peak)), r.u_max, "N"),
+                      ("|x1|", float(np.max(self.x1_peak)), r.z_max, "m"),
                       ("peak / own limit at the design seat", self.nominal_ratio,
                        r.nominal_ratio, "×"),
                       ("1 kHz loop's peak against the continuous one", self.sampled_gap,
@@ -390,7 +394,7 @@ class SeatCertificate:
 
 
 def certify_seat(K, *, Kd=None, params: SeatParameters | None = None,
-                 delays=CERTIFY_DELAYS, design=None, occupants=None, mixed_mu: bool = False,
+                 delays=REFINE_DELAYS, design=None, occupants=None, mixed_mu: bool = False,
                  requirements: SeatRequirements | None = None,
                  rng: np.random.Generator | None = None,
                  progress: Callable[[str], None] | None = None) -> SeatCertificate:
@@ -413,8 +417,8 @@ def certify_seat(K, *, Kd=None, params: SeatParameters | None = None,
     params : SeatParameters, optional
         The design seat (Table 1 by default).
     delays : sequence of float
-        Delays the bump is met at, s; ``()`` leaves the bump out (µ, poles and worst
-        cases only, a second or two).
+        Delays the bump is met at, s (issue 38's 0, 5, ..., 25 ms by default); ``()``
+        leaves the bump out (µ, poles and worst cases only, a second or two).
     design : SeatDesignOptions, optional
         µ weights and delay cover (:data:`~.design.DEFAULT_DESIGN` by default).
     occupants : OccupantSamples, optional
@@ -478,10 +482,14 @@ def certify_seat(K, *, Kd=None, params: SeatParameters | None = None,
     say("µ bounds on a dense grid, worst cases and poles")
     aug = seat_augmented_plant(design, params)
     omega = np.logspace(-3.0, 4.0, 300)
-    # the grid and the loop's lightly damped poles' frequencies, where a µ peak is sharp
-    _, _, at = TwoBlockMu(design, omega, params).peaks(K, 8)
-    omega = np.unique(np.concatenate([omega, at, resonances(
-        lft(aug.P, control.ss(K.A, K.B, K.C, K.D), aug.nmeas, aug.ncon), omega)]))
+    # the grid and the loop's lightly damped poles' frequencies, where a µ peak is sharp;
+    # on the two full blocks of the delay cover and performance, also the refined maxima
+    # of their µ formula (other structures have none)
+    extra = [resonances(lft(aug.P, control.ss(K.A, K.B, K.C, K.D), aug.nmeas, aug.ncon),
+                        omega)]
+    if np.asarray(aug.blk).shape[0] == 2:
+        extra.append(TwoBlockMu(design, omega, params).peaks(K, 8)[2])
+    omega = np.unique(np.concatenate([omega, *extra]))
     mu = certify_constrained(K, design=design, params=params, omega=omega, rng=rng_mu)
     limit = float(bump_limit(road, params, dt=_LIMIT_DT).certified_peak) if delays \
         else math.nan
@@ -526,7 +534,8 @@ def _jsonable(obj):
 def save_seat_design(path, d: SeatDesign) -> Path:
     """Write a design as a controller file (``controller.json``'s format): both
     realizations, the route, the seat, the figures and the description in its metadata.
-    :func:`load_seat_design` reads it back equal (``detail`` aside)."""
+    :func:`load_seat_design` reads every field back equal (the matrices bit for bit),
+    ``detail`` aside."""
     from ..io import save_controller
 
     if not isinstance(d, SeatDesign):
@@ -563,6 +572,10 @@ def load_seat_design(path_or_route, *, route: str | None = None) -> SeatDesign:
 
     if isinstance(path_or_route, str) and path_or_route in SHIPPED_DESIGNS:
         route, path = path_or_route, SHIPPED_DESIGNS[path_or_route]
+    elif isinstance(path_or_route, str) and path_or_route in ROUTE_NAMES:
+        raise InputError(f"no shipped design of route {path_or_route!r} (the shipped ones: "
+                         f"{', '.join(SHIPPED_DESIGNS)}); design it: "
+                         f"design_seat({path_or_route!r})")
     else:
         path = Path(path_or_route)
     K, meta = load_controller(path)
@@ -573,6 +586,9 @@ def load_seat_design(path_or_route, *, route: str | None = None) -> SeatDesign:
     name = meta.get("route", route)
     if name is None:
         raise InputError(f"{path} names no route: pass route=")
+    if route is not None and name != route:
+        raise InputError(f"{path} holds a design of route {name!r}, not {route!r}")
+    K = control.ss(K.A, K.B, K.C, K.D, inputs=["x1", "x3"], outputs=["u"], name=f"K_{name}")
     params = SeatParameters(**meta["params"]) if "params" in meta else SeatParameters()
     weights = (SeatDesignOptions(**{k: tuple(v) if isinstance(v, list) else v
                                     for k, v in meta["weights"].items()})

@@ -33,8 +33,8 @@ import numpy as np
 from ..errors import InputError, ParameterError
 from ..seat.params import SeatParameters
 
-__all__ = ["DESIGN", "design_route", "PASSIVE", "PLANT_AXES", "ROADS", "SAMPLINGS", "Case", "SweepSpec",
-           "parse_range"]
+__all__ = ["DESIGN", "design_route", "PASSIVE", "PLANT_AXES", "ROADS", "SAMPLINGS", "Case",
+           "SweepSpec", "parse_range"]
 
 #: the seat's parameters a sweep may vary (the delay bounds of SeatParameters are the
 #: design's, not a case's: a case has one delay)
@@ -244,8 +244,9 @@ class SweepSpec:
         if routes:
             from ..seat.routes import ROUTE_NAMES
 
-            for route in sorted(routes - set(ROUTE_NAMES)):
-                raise ParameterError(f"controllers: unknown design route {route!r} "
+            unknown = sorted(routes - set(ROUTE_NAMES))
+            if unknown:
+                raise ParameterError(f"controllers: unknown design route {unknown[0]!r} "
                                      f"(design:<route>, the routes are "
                                      f"{', '.join(ROUTE_NAMES)})")
         known = self.axes_known()
