@@ -600,7 +600,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     p_de = sub.add_parser("design",
                           help="design a seat controller along a route with its default "
-                               "choices (seconds to tens of minutes), write it, certify it")
+                               "choices (seconds to tens of minutes), write it, certify it "
+                               "(exit status 1 where the route's own requirements are not "
+                               "met; the certificate's verdict on issue 38's targets is "
+                               "printed)")
     p_de.add_argument("route", choices=("mu", "constrained", "refined", "occupants",
                                         "peak_bounded"),
                       help="mu: D-K as in the paper (seconds); constrained: hard force/stroke "
