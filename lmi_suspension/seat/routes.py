@@ -46,10 +46,12 @@ import numpy as np
 
 from ..errors import InputError, ParameterError
 from .augmented import SeatDesignOptions
-from .constrained import SHIPPED_CONTROLLER
-from .multimodel import SHIPPED_OCCUPANTS
+from .bounded import PeakBoundedRoute
+from .constrained import CONSTRAINED_DESIGN, SHIPPED_CONTROLLER, ConstrainedRoute
+from .design import DEFAULT_DESIGN, MuRoute
+from .multimodel import SHIPPED_OCCUPANTS, OccupantRoute
 from .params import SeatParameters
-from .refine import REFINE_DELAYS, SHIPPED_REFINED
+from .refine import REFINE_DELAYS, SHIPPED_REFINED, RefineRoute
 
 __all__ = ["SeatRoute", "SeatDesign", "SeatRequirements", "SeatCertificate", "ROUTE_NAMES",
            "SHIPPED_DESIGNS", "route_named", "design_seat", "certify_seat",
@@ -57,8 +59,10 @@ __all__ = ["SeatRoute", "SeatDesign", "SeatRequirements", "SeatCertificate", "RO
 
 logger = logging.getLogger(__name__)
 
+_ROUTES = MappingProxyType({route.name: route for route in (
+    MuRoute, ConstrainedRoute, RefineRoute, OccupantRoute, PeakBoundedRoute)})
 #: the routes shipped with the package, by name (:func:`route_named`)
-ROUTE_NAMES = ("mu", "constrained", "refined", "occupants", "peak_bounded")
+ROUTE_NAMES = tuple(_ROUTES)
 
 #: the designs shipped with the package, by route name (their searches take minutes to
 #: hours; ``reproduce`` loads and re-certifies them).  The µ design is not among them:
@@ -178,23 +182,10 @@ def route_named(name: str) -> SeatRoute:
     ParameterError
         An unknown name.
     """
-    if name == "mu":
-        from .design import MuRoute
-        return MuRoute()
-    if name == "constrained":
-        from .constrained import ConstrainedRoute
-        return ConstrainedRoute()
-    if name == "refined":
-        from .refine import RefineRoute
-        return RefineRoute()
-    if name == "occupants":
-        from .multimodel import OccupantRoute
-        return OccupantRoute()
-    if name == "peak_bounded":
-        from .bounded import PeakBoundedRoute
-        return PeakBoundedRoute()
-    raise ParameterError(f"unknown seat design route {name!r}; the routes are "
-                         f"{', '.join(ROUTE_NAMES)}")
+    if name not in _ROUTES:
+        raise ParameterError(f"unknown seat design route {name!r}; the routes are "
+                             f"{', '.join(ROUTE_NAMES)}")
+    return _ROUTES[name]()
 
 
 def design_seat(route: SeatRoute | str = "mu", *, params: SeatParameters | None = None,
@@ -448,7 +439,6 @@ def certify_seat(K, *, Kd=None, params: SeatParameters | None = None,
     from ..mu.steps.dgstep import resonances
     from .augmented import seat_augmented_plant
     from .constrained import certify_constrained
-    from .design import DEFAULT_DESIGN
     from .limit import bump_limit
     from .refine import _LIMIT_DT, TwoBlockMu, loop_poles
     from .roads import bump
@@ -550,9 +540,6 @@ _META_KEYS = ("route", "description", "params", "weights", "design_seconds",
 
 def _default_weights(route: str) -> SeatDesignOptions:
     """The µ weights of a route's default choices (for files that do not say)."""
-    from .constrained import CONSTRAINED_DESIGN
-    from .design import DEFAULT_DESIGN
-
     return CONSTRAINED_DESIGN if route == "constrained" else DEFAULT_DESIGN
 
 
