@@ -259,12 +259,13 @@ class SeatRequirements:
         The 1 kHz sampled-data loop's peak within this fraction of the continuous one's.
     """
 
-    u_max: float = 1500.0
-    z_max: float = 0.08
+    # the paper's limits are the seat's own (eqs. 12-13, the delay range): one source
+    u_max: float = SeatParameters.u_max
+    z_max: float = SeatParameters.z_max
     nominal_ratio: float = 1.3
     worst_ratio: float = 1.5
     pole_radius: float = 1900.0
-    delay_max: float = 0.025
+    delay_max: float = SeatParameters.delay_max
     sampled_tolerance: float = 0.01
 
     def __post_init__(self):
