@@ -318,6 +318,14 @@ def _cmd_occupants(args: argparse.Namespace) -> int:
             line += (f"  {m.rs_sup:6.3f} ({m.rs_lower:5.3f})  {m.rp_sup:6.3f} "
                      f"({m.rp_lower:5.3f})")
         sys.stdout.write(line + "\n")
+        for w in cert.worst_seats:
+            row[f"searched_{w.figure}"] = dict(
+                value=w.value if math.isfinite(w.value) else None,   # null: unstable
+                delay=w.delay, evaluations=w.evaluations,
+                seat={k: getattr(w.seat, k) for k in ("m3", "k1", "k2", "k3", "c1", "c2",
+                                                      "c3")})
+            sys.stdout.write(f"{'':>14} searched {'|u|' if w.figure == 'u' else '|x1|'}: "
+                             f"{w.describe()}\n")
         failures = cert.failures()
         row["requirements_not_met"] = list(failures)
         verdicts.append(f"{name}: " + ("all met" if not failures else "; ".join(failures)))

@@ -98,6 +98,7 @@ def test_search_ranks_violations_then_ratios_and_stops_at_an_unstable_seat(K_ref
     A, B, C, D = (SeatParameters(m3=m) for m in (31.0, 32.0, 33.0, 34.0))
     found = [(np.inf, np.inf, A), (-0.05, 50.0, B), (-0.30, 60.0, C), (0.1, 1.0, D)]
     monkeypatch.setattr(multimodel, "_search", lambda K, seats, opts, road: found)
+    monkeypatch.setattr(multimodel, "_corner_search", lambda *args: ((), []))
     d = refine_for_occupants(K_refined, OccupantSet(damping_rel=0.0),
                              RefineOptions(max_iter=1), rng=np.random.default_rng(0),
                              rounds=3, n_search=4, add=2, corners=("m3",))
@@ -105,3 +106,36 @@ def test_search_ranks_violations_then_ratios_and_stops_at_an_unstable_seat(K_ref
     r = d.rounds[0]
     assert r.added == (D, C) and r.unstable == (A,)
     assert r.violations_found == 2 and r.worst_found == np.inf
+
+
+def test_a_corner_the_search_finds_ranks_with_the_violations(K_refined, monkeypatch):
+    """A violation found at the set's corners joins the samples' violations by its
+    excess (its ratio is not computed), and the round records the search's seats."""
+    from lmi_suspension.seat import multimodel
+    from lmi_suspension.seat.params import SeatParameters
+
+    monkeypatch.setattr(refine, "_STAGE_ITER", 1)
+    B, C, D, E = (SeatParameters(m3=m) for m in (32.0, 33.0, 34.0, 35.0))
+    found = [(-0.05, 50.0, B), (-0.30, 60.0, C), (0.1, 1.0, D)]
+    monkeypatch.setattr(multimodel, "_search", lambda K, seats, opts, road: list(found))
+    monkeypatch.setattr(multimodel, "_corner_search",
+                        lambda *args: (("u", "x1"), [(0.2, np.nan, E)]))
+    d = refine_for_occupants(K_refined, OccupantSet(damping_rel=0.0),
+                             RefineOptions(max_iter=1), rng=np.random.default_rng(0),
+                             rounds=1, n_search=4, add=2, corners=("m3",))
+    r = d.rounds[0]
+    assert r.added == (E, D) and r.violations_found == 2 and r.worst_found == 60.0
+    assert r.worst_seats == ("u", "x1")
+
+
+def test_the_corner_search_reports_only_what_exceeds_its_bound(K_refined):
+    """The refined controller asks 2236 N at the set's worst corner (issue 38's note,
+    2026-11-28), above 1500 N: a violation with that excess; its stroke (0.074 m) is
+    within 0.08 m and is not one."""
+    from lmi_suspension.seat.multimodel import _corner_search
+
+    occ = OccupantSet()
+    (u, x1), violations = _corner_search(K_refined, occ, RefineOptions(), bump(),
+                                         np.random.default_rng(0))
+    assert u.value > 1500.0 and x1.value < 0.08
+    assert violations == [(pytest.approx(u.value / 1500.0 - 1), pytest.approx(np.nan, nan_ok=True), u.seat)]

@@ -324,6 +324,16 @@ def test_occupant_map_is_what_direct_computations_give(run):
     table = R.comparison_table(run.summary)
     assert "controller.json (µ, every occupant)" in table
     assert f"{w['limit_ratio']:.2f} × its own limit" in table
+    # the set's worst force and stroke by search (quick: the 128 corners at the run's
+    # two delays), each attained at its seat by a direct simulation
+    for key, figure in (("u", "peak_u_command"), ("x1", "peak_x1")):
+        found = grid["searched"][key]
+        assert found["evaluations"] == 128 and found["delay"] in (0.0, 0.025)
+        seat = SeatParameters(**found["seat"])
+        m = simulate(K_OCCUPANTS, bump(), delay=found["delay"], params=seat,
+                     u_max=np.inf).metrics()
+        assert getattr(m, figure) <= found["value"] <= getattr(m, figure) * 1.01
+        assert found["text"] in " ".join(table.split())     # wrapped to the table
 
 
 @pytest.mark.slow

@@ -28,6 +28,7 @@ from lmi_suspension.seat.routes import (ROUTE_NAMES, SHIPPED_DESIGNS, SeatCertif
                                         certify_seat, design_seat, load_seat_design,
                                         route_named, save_seat_design, seat_design_from)
 from lmi_suspension.seat.sampled import discretise_controller
+from lmi_suspension.seat.worstcase import worst_bump_seats
 
 PASSIVE = control.ss([], [], [], [[0.0, 0.0]])
 
@@ -110,6 +111,30 @@ def test_a_nan_figure_is_a_failure_not_a_pass():
     edge = dataclasses.replace(base, u_peak=(1500.0, 0.0), loop_radius=1900.0,
                                requirements=SeatRequirements(nominal_ratio=100.0))
     assert [f.split(":")[0] for f in edge.failures()] == ["poles"]
+
+
+def test_the_searched_worst_seats_are_judged():
+    """The set's searched force and stroke: at the bound passes, above it fails with the
+    seat named, an unstable seat fails, a nan fails."""
+    from lmi_suspension.seat.worstcase import WorstSeat
+
+    base = dataclasses.replace(certify_seat(PASSIVE, delays=()), loop_radius=0.0)
+    assert base.worst_seats == () and base.met
+
+    def judged(u, x1):
+        seats = tuple(WorstSeat(figure=f, value=v, seat=SeatParameters(m3=30.0),
+                                delay=0.0, evaluations=1)
+                      for f, v in (("u", u), ("x1", x1)))
+        return dataclasses.replace(base, worst_seats=seats).failures()
+
+    assert judged(1500.0, 0.08) == ()
+    assert judged(1501.0, 0.08) == ("set, searched: commanded |u| 1501 N at m3 30.0 kg, "
+                                    "k1 31000, k2 18000, k3 44130 N/m, c1 830, c2 200, "
+                                    "c3 1485 N s/m, 0 ms, above 1500",)
+    assert [f[:22] for f in judged(1500.0, 0.0801)] == ["set, searched: |x1| 0."]
+    assert judged(math.inf, math.inf)[0].startswith("set, searched: the loop is unstable "
+                                                    "at m3 30.0 kg")
+    assert judged(math.nan, 0.0)[0].startswith("set, searched: commanded |u| nan N")
 
 
 def test_the_passive_seat_is_judged_against_the_requirements():
@@ -265,3 +290,12 @@ def test_the_set_is_certified_and_judged_when_samples_are_given(peak_bounded):
     assert any(f.startswith("set: worst peak / own limit") for f in failures) == (
         o.worst_ratio > c.requirements.worst_ratio)
     assert c.mixed_mu is None
+    # the search over the set's corners, on the third stream spawned from the default
+    # generator (the first two are the µ lower bounds'), judged like the samples
+    u, x1 = c.worst_seats
+    assert (u.figure, x1.figure) == ("u", "x1")
+    again = worst_bump_seats(peak_bounded.K, S.occupants,
+                             rng=np.random.default_rng(0).spawn(3)[2])
+    assert (u.value, u.seat, x1.value) == (again[0].value, again[0].seat, again[1].value)
+    assert any(f.startswith("set, searched: commanded |u|") for f in failures) == (
+        u.value > c.requirements.u_max)

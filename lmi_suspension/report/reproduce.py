@@ -90,6 +90,10 @@ class _Settings:
     map_delays: tuple
     map_step: float
     map_t_end: float
+    #: the search for the set's worst force and stroke (``worst_bump_seats``): samples
+    #: besides the 128 corners, and climbs per figure
+    search_n: int = 200
+    search_starts: int = 3
 
 
 # The map reaches past the set (m3 30-70 kg, k1 ±20 %) far enough to show where the
@@ -106,7 +110,8 @@ _FULL = _Settings(bump_t_end=3.0, noise_t_end=3.0, iso_t_end=3.0, road_dt=1e-3, 
                   map_delays=(0.0, 0.025), map_step=5e-4, map_t_end=1.5)
 _QUICK = _Settings(bump_t_end=1.5, noise_t_end=1.0, iso_t_end=1.0, road_dt=1e-3, sim_dt=5e-4,
                    limit_dt=5e-3, mc_n=4, mc_workers=0, map_m3=(30.0, 70.0),
-                   map_k1_rel=(-0.5, 0.0, 0.2), map_delays=(0.025,), map_step=5e-4, map_t_end=1.5)
+                   map_k1_rel=(-0.5, 0.0, 0.2), map_delays=(0.025,), map_step=5e-4, map_t_end=1.5,
+                   search_n=0, search_starts=0)
 
 
 def _monte_carlo(controller: Path, cfg: _Settings, delay_range, params, seed: int,
@@ -768,10 +773,14 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                              delay=map_worst["delay"], params=worst_seat, dt=cfg.map_step)
         map_data["worst_in_set"]["replayed_peak_z3dd"] = float(
             np.max(np.abs(worst_run.z3dd)))
+    # the set's corners, where the force peaks and which the map's plane does not reach
+    map_data["searched"] = _searched_worst(K_export, params, delays, cfg,
+                                           int(rng_mc.integers(2**63)))
     done(tok)
     say(f"  {map_data['unstable_cells_in_set']} unstable cells in the set, "
         f"{map_data['unstable_cells']} in the map; worst in the set: "
         + _map_worst_text(map_data["worst_in_set"]))
+    say("  " + _searched_text(map_data["searched"]))
 
     # --- figures ---------------------------------------------------------------------
     tok = stage("figures", "writing figures ...")
@@ -881,6 +890,11 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     if exported != EXPORTED:
         facts += (f"controller.json holds the {_LONG_NAMES[exported]} design: "
                   f"{_LONG_NAMES[EXPORTED]} failed ({errors.get(EXPORTED, 'not loaded')})",)
+    over = [w for w in map_data["searched"].values()
+            if not w["value"] <= {"u": params.u_max, "x1": params.z_max}[w["figure"]]]
+    if over:
+        facts += ("controller.json exceeds a road requirement at a seat of its set (found "
+                  "by search): " + "; ".join(w["text"] for w in over),)
     if map_data["failed_cells"] or map_data["cells_in_set_without_limit"]:
         facts += (f"occupant map: {map_data['failed_cells']} cells raised (occupant_map/"
                   f"results.parquet has the errors) and {map_data['cells_in_set_without_limit']}"
@@ -927,6 +941,29 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                             limit_peak=float(limit.peak), mu_peak=float(mu_design.mu_peak),
                             mu_lower_peak=float(mu_design.mu_lower_peak), seconds=total,
                             timings=dict(timings), data=data, facts=facts)
+
+
+def _searched_worst(K, params, delays, cfg: _Settings, seed: int) -> dict:
+    """The exported controller's largest commanded force and stroke over its set, by
+    search (:func:`~lmi_suspension.seat.worstcase.worst_bump_seats`): the summary's
+    ``occupant_map["searched"]``, one entry per figure."""
+    from ..seat.occupants import OccupantSet
+    from ..seat.worstcase import worst_bump_seats
+
+    found = worst_bump_seats(K, OccupantSet(nominal=params), rng=np.random.default_rng(seed),
+                             n=cfg.search_n, starts=cfg.search_starts, delays=delays)
+    return {w.figure: {"figure": w.figure, "value": w.value, "delay": w.delay,
+                       "seat": {k: getattr(w.seat, k) for k in
+                                ("m3", "k1", "k2", "k3", "c1", "c2", "c3")},
+                       "evaluations": w.evaluations, "text": w.describe()}
+            for w in found}
+
+
+def _searched_text(searched: Mapping) -> str:
+    """The search's worst force and stroke, in one phrase."""
+    names = {"u": "commanded |u|", "x1": "|x1|"}
+    return ("largest over the set by search: "
+            + "; ".join(f"{names[k]} {w['text']}" for k, w in searched.items()))
 
 
 def _map_worst_text(worst: Mapping | None) -> str:
@@ -1065,6 +1102,8 @@ def comparison_table(summary: ReproduceSummary) -> str:
             f"{grid['unstable_cells_in_set']} unstable in the set, {grid['unstable_cells']} "
             f"in the map; worst in the set {_map_worst_text(grid['worst_in_set'])}",
             width=len(head)))
+        if grid.get("searched"):
+            lines.append(textwrap.fill(_searched_text(grid["searched"]), width=len(head)))
     # one screen: the facts wrapped to the table's width
     lines += [textwrap.fill(fact, width=len(head), initial_indent="- ",
                             subsequent_indent="  ") for fact in summary.facts]

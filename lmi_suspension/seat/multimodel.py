@@ -10,9 +10,11 @@ the worst of each seat's peak ``|z̈3|`` over its own physical limit is minimise
 ``RefineOptions.occupants``, robust stability over the whole set (mixed µ,
 :class:`~.occupants.MixedRsBound`) is required as well.  Then
 ``n_search`` Latin-hypercube samples of the :class:`~.occupants.OccupantSet` are met by
-the result; the samples that violate a requirement, or whose ratio exceeds the rounds'
-worst over its seats, are added (at most ``add`` per round, the worst first), and the
-next round starts from the result.  The loop ends when a search finds nothing to add,
+the result, and the set's corners and a climb from the worst of them look for the
+largest force and stroke (:func:`~.worstcase.worst_bump_seats`: samples rarely come near
+a corner, where the force peaks); the seats that violate a requirement, or whose ratio
+exceeds the rounds' worst over its seats, are added (at most ``add`` per round,
+violations first, the worst first), and the next round starts from the result.  The loop ends when a search finds nothing to add,
 finds a seat where the loop is unstable (reported, not added: a refinement starts from a
 loop that is stable at every seat it serves), or after ``rounds`` rounds.
 
@@ -23,6 +25,7 @@ did not draw and by :func:`~.occupants.occupant_mu`.
 from __future__ import annotations
 
 import logging
+import math
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -37,6 +40,7 @@ from .occupants import OccupantSet
 from .refine import (_LIMIT_DT, BumpResponse, RefinedDesign, RefineOptions, loop_poles,
                      refine_seat_controller)
 from .roads import RoadInput, bump
+from .worstcase import worst_bump_seats
 
 __all__ = ["OccupantRound", "OccupantDesign", "OccupantRoute", "SHIPPED_OCCUPANTS",
            "refine_for_occupants"]
@@ -77,6 +81,8 @@ class OccupantRound:
         seat it serves.  The loop stops after a round that finds one (a user decides:
         another start, a smaller set).
     seconds : float
+    worst_seats : tuple of WorstSeat
+        The largest force and stroke found over the set's corners and a climb.
     """
 
     index: int
@@ -87,6 +93,7 @@ class OccupantRound:
     added: tuple
     unstable: tuple
     seconds: float
+    worst_seats: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -130,6 +137,22 @@ def _search(K, seats, opts: RefineOptions, road: RoadInput) -> list:
     return out
 
 
+def _corner_search(K, occupants: OccupantSet, opts: RefineOptions, road: RoadInput,
+                   rng: np.random.Generator) -> tuple[tuple, list]:
+    """The set's largest force and stroke over its corners and a climb
+    (:func:`~.worstcase.worst_bump_seats`, no samples: ``_search`` has met them), and
+    ``(violation, nan, seat)`` for each that exceeds its bound: violations rank by their
+    excess, so the seat's ratio is not needed."""
+    worst_seats = worst_bump_seats(K, occupants, rng=rng, n=0, delays=opts.delays,
+                                   road=road)
+    violations = []
+    for w in worst_seats:
+        excess = w.value / (opts.u_bound if w.figure == "u" else opts.z_bound) - 1
+        if excess > 0:
+            violations.append((excess, math.nan, w.seat))
+    return worst_seats, violations
+
+
 def refine_for_occupants(K0, occupants: OccupantSet | None = None,
                          options: RefineOptions | None = None, *, rng: np.random.Generator,
                          rounds: int = 3, n_search: int = 40, add: int = 2,
@@ -149,7 +172,7 @@ def refine_for_occupants(K0, occupants: OccupantSet | None = None,
         the corners of ``corners``' ranges (:meth:`~.occupants.OccupantSet.corners`).
         ``options.max_iter`` is per round.
     rng : numpy.random.Generator
-        Draws the search samples.
+        Draws the search samples (the corners' search draws none).
     rounds, n_search, add : int
         Bounds of the loop: rounds, search samples per round, seats added per round.
     corners : tuple of str
@@ -184,19 +207,22 @@ def refine_for_occupants(K0, occupants: OccupantSet | None = None,
         K = d.K
         seats, _ = occupants.sample(n_search, rng)
         found = _search(K, seats, opts, road)
+        worst_found = max(f[1] for f in found)
+        worst_seats, violations = _corner_search(K, occupants, opts, road, rng)
+        found = list(found) + violations
         worst = float(np.max(d.peak))
         unstable = tuple(p for v, _, p in found if v == np.inf)
         # violations first, the largest first; then the seats that meet the bounds, by
         # ratio, where it exceeds the seats' worst
         ranked = sorted((f for f in found if f[0] < np.inf),
                         key=lambda f: (0, -f[0]) if f[0] > 0 else (1, -f[1]))
-        added = tuple(p for v, r, p in ranked
-                      if v > 0 or r > worst * (1 + _ADD_TOL))[:add]
+        added = tuple(dict.fromkeys(p for v, r, p in ranked     # a seat once
+                                    if v > 0 or r > worst * (1 + _ADD_TOL)))[:add]
         rec = OccupantRound(index=index, plants=tuple(plants), design=d,
-                            worst_found=max(f[1] for f in found),
+                            worst_found=worst_found,
                             violations_found=sum(f[0] > 0 for f in found), added=added,
-                            unstable=unstable,
-                            seconds=time.perf_counter() - t_round)
+                            unstable=unstable, seconds=time.perf_counter() - t_round,
+                            worst_seats=worst_seats)
         history.append(rec)
         logger.info("occupant round %d: %d seats, worst ratio %.3f on them, %.3f on the "
                     "search (%d violations), %d added (%.0f s)", index, len(plants) + 1,
@@ -217,8 +243,10 @@ def _round_line(r: OccupantRound) -> str:
     """One line of progress for a round."""
     return (f"round {r.index}: {len(r.plants) + 1} seats, worst peak/limit "
             f"{np.max(r.design.peak):.3f}, |u| {np.max(r.design.u_peak):.0f} N, met "
-            f"{r.design.met}; search: worst {r.worst_found:.3f}, {r.violations_found} "
-            f"violations, {len(r.added)} seats added ({r.seconds:.0f} s)")
+            f"{r.design.met}; search: worst {r.worst_found:.3f}, "
+            + "".join(f"{w.figure} {w.value:.4g}, " for w in r.worst_seats)
+            + f"{r.violations_found} violations, {len(r.added)} seats added "
+            f"({r.seconds:.0f} s)")
 
 
 @dataclass(frozen=True)

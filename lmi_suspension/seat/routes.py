@@ -304,6 +304,10 @@ class SeatCertificate:
         :func:`~.limit.bump_limit`), m/s²; nan without delays.
     occupants : OccupantCheck or None
         Stability and road figures over the samples of a set of seats.
+    worst_seats : tuple of WorstSeat
+        The seats of that set where the commanded force and the stroke were found
+        largest by search (:func:`~.worstcase.worst_bump_seats`; empty without the set):
+        the set's corners and a climb, which samples rarely come near.
     mixed_mu : MixedMuCheck or None
         Mixed µ over that set (robust stability and performance).
     requirements : SeatRequirements
@@ -321,6 +325,7 @@ class SeatCertificate:
     occupants: object = None
     mixed_mu: object = None
     requirements: SeatRequirements = field(default_factory=SeatRequirements)
+    worst_seats: tuple = ()
 
     @property
     def nominal_ratio(self) -> float:
@@ -375,6 +380,13 @@ class SeatCertificate:
             if not o.loop_radius < r.pole_radius:
                 out.append(f"set: fastest loop pole {o.loop_radius:.0f} rad/s, not below "
                            f"{r.pole_radius:g}")
+        for w in self.worst_seats:
+            bound = {"u": r.u_max, "x1": r.z_max}[w.figure]
+            if not w.value <= bound:
+                what = {"u": "commanded |u|", "x1": "|x1|"}[w.figure]
+                out.append(f"set, searched: {what} {w.describe()}, above {bound:g}"
+                           if w.value != math.inf else
+                           f"set, searched: the loop is {w.describe()}")
         if self.mixed_mu is not None and not self.mixed_mu.rs_sup < 1.0:
             out.append(f"set: robust-stability mixed µ {self.mixed_mu.rs_sup:.4f}, not below 1")
         return tuple(out)
@@ -387,7 +399,7 @@ class SeatCertificate:
 
 def certify_seat(K, *, Kd=None, params: SeatParameters | None = None,
                  delays=REFINE_DELAYS, design=None, occupants=None, mixed_mu: bool = False,
-                 requirements: SeatRequirements | None = None,
+                 requirements: SeatRequirements | None = None, search: bool = True,
                  rng: np.random.Generator | None = None,
                  progress: Callable[[str], None] | None = None) -> SeatCertificate:
     """Certify a seat controller by routes no design uses to produce it.
@@ -397,8 +409,9 @@ def certify_seat(K, *, Kd=None, params: SeatParameters | None = None,
     dense grid refined at the loop's resonances; worst-case force and stroke over every
     floor velocity of the bump's energy (Gramian); pole magnitudes; the delay margin;
     the seat's own physical limit (LP).  Given samples of a set of seats, stability and
-    road figures over them (:func:`~.occupants.certify_occupants`) and, with
-    ``mixed_mu``, the set's mixed µ (:func:`~.occupants.occupant_mu`).
+    road figures over them (:func:`~.occupants.certify_occupants`), the seats of the
+    set where force and stroke are worst (:func:`~.worstcase.worst_bump_seats`) and,
+    with ``mixed_mu``, the set's mixed µ (:func:`~.occupants.occupant_mu`).
 
     Parameters
     ----------
@@ -418,9 +431,12 @@ def certify_seat(K, *, Kd=None, params: SeatParameters | None = None,
     mixed_mu : bool
         Also the set's mixed µ (needs ``occupants``; about a minute).
     requirements : SeatRequirements, optional
+    search : bool
+        With ``occupants``, also search the set for its worst force and stroke (about
+        15 s): its corners, 200 samples of its own and a climb from the worst.
     rng : numpy.random.Generator, optional
-        Seeds the µ lower bounds (``default_rng(0)`` by default): two streams spawned
-        from it, one for the seat's µ and one for the set's.
+        Seeds the µ lower bounds and the search (``default_rng(0)`` by default): three
+        streams spawned from it, for the seat's µ, the set's µ and the search.
     progress : callable, optional
         Called with a line of text per part.
 
@@ -452,6 +468,8 @@ def certify_seat(K, *, Kd=None, params: SeatParameters | None = None,
     if K.ninputs != 2 or K.noutputs != 1:
         raise ParameterError(f"K must map y = [x1, x3] to u (2 inputs, 1 output), got "
                              f"{K.ninputs} inputs, {K.noutputs} outputs")
+    if not isinstance(search, bool):
+        raise ParameterError(f"search must be True or False, got {search!r}")
     if mixed_mu and occupants is None:
         raise ParameterError("mixed_mu needs the set: pass occupants=occupant_samples(...)")
     params = SeatParameters() if params is None else params
@@ -460,7 +478,8 @@ def certify_seat(K, *, Kd=None, params: SeatParameters | None = None,
     if not isinstance(rng, np.random.Generator):
         raise ParameterError("rng must be a numpy.random.Generator")
     # one stream per part, so that adding a part does not move another's lower bound
-    rng_mu, rng_set = rng.spawn(2)
+    # (spawn's children are numbered: the first two are those of spawn(2))
+    rng_mu, rng_set, rng_search = rng.spawn(3)
     design = DEFAULT_DESIGN if design is None else design
     delays = tuple(float(d) for d in delays)
     Kd = discretise_controller(K) if Kd is None else Kd
@@ -485,12 +504,19 @@ def certify_seat(K, *, Kd=None, params: SeatParameters | None = None,
     limit = float(bump_limit(road, params, dt=_LIMIT_DT).certified_peak) if delays \
         else math.nan
     check = occ_mu = None
+    worst = ()
     if occupants is not None:
         from .occupants import certify_occupants, occupant_mu
 
         say(f"the set: {len(occupants.stability)} stability and "
             f"{len(occupants.performance)} performance samples")
         check = certify_occupants(K, occupants, progress=progress)
+        if search:
+            from .worstcase import worst_bump_seats
+
+            say("the set's worst force and stroke, by search")
+            worst = worst_bump_seats(K, occupants.occupants, rng=rng_search,
+                                     road=occupants.road)
         if mixed_mu:
             say("the set's mixed µ")
             occ_mu = occupant_mu(K, occupants.occupants, design=design, rng=rng_set)
@@ -500,7 +526,7 @@ def certify_seat(K, *, Kd=None, params: SeatParameters | None = None,
                            mu=mu, delay_margin=float(stability_delay_margin(K, params)),
                            loop_radius=float(np.max(np.abs(loop_poles(K, params)))),
                            limit=limit, occupants=check, mixed_mu=occ_mu,
-                           requirements=requirements)
+                           requirements=requirements, worst_seats=worst)
 
 
 # ------------------------------------------------------------------------------ files
