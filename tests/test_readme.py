@@ -50,7 +50,7 @@ _SECOND_PASS_EXEMPT = {"test_cli.py", "test_design.py", "test_reproduce.py", "te
                        "test_readme.py"}
 #: entry points of the iterative numerical routines (synthesis, µ, D-K, intervals, ...)
 _ITERATIVE = re.compile(r"\b(hinfsyn|hinfnorm|mussv|musyn|msyn|h2hinfsyn|interval_bound|"
-                        r"refine_\w+|fit_dscales|search_dscales|robstab|wcgain)\b")
+                        r"refine_\w+|fit_dscales|search_dscales|robstab|wcgain|worst_bump_seats)\b")
 
 
 def test_second_pass_names_every_iterative_numerical_module():
