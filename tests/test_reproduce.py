@@ -334,6 +334,12 @@ def test_occupant_map_is_what_direct_computations_give(run):
                      u_max=np.inf).metrics()
         assert getattr(m, figure) <= found["value"] <= getattr(m, figure) * 1.01
         assert found["text"] in " ".join(table.split())     # wrapped to the table
+    # a requirement missed at a searched seat is one of the run's facts
+    over = [k for k, bound in (("u", 1500.0), ("x1", 0.08))
+            if not grid["searched"][k]["value"] <= bound]
+    fact = [f for f in data["facts"] if "found by search" in f]
+    assert len(fact) == (1 if over else 0)
+    assert all(grid["searched"][k]["text"] in fact[0] for k in over)
 
 
 @pytest.mark.slow

@@ -42,19 +42,20 @@ def _figures(K, seat):
 
 
 def test_force_at_the_worst_corner_beats_every_sample(K, found):
-    """The force the search reports is attained at its seat (time simulation with the
-    exact delay, unclipped: the reported value is the larger of it and the FFT's, which
-    agree to 1 %), is at least every corner's (all 128 met here), and is above every one
-    of 200 fresh samples', the certificate that samples alone gave before."""
+    """The force the search reports is the time simulation's at its seat (exact delay,
+    unclipped), and the closed-form figure it ranked the seats by agrees with it to 1 %
+    (0.1-0.5 % measured); it is at least every corner's (all 128 met here) and above
+    every one of 200 fresh samples', the certificate that samples alone gave before."""
     u, _ = found
     assert u.figure == "u" and u.evaluations >= 128 + 50
     m = simulate(K, bump(), delay=u.delay, params=u.seat, u_max=np.inf).metrics()
-    assert m.peak_u_command <= u.value <= m.peak_u_command * 1.01
+    assert u.value == m.peak_u_command
+    assert u.frequency_value == pytest.approx(u.value, rel=0.01)
     occ = OccupantSet()
     ranges = occ.ranges()
     corners = [occ.at({r[0]: r[1 + b] for r, b in zip(ranges, c)})
                for c in product((0, 1), repeat=7)]
-    assert u.value >= max(_figures(K, p)[0] for p in corners)
+    assert u.frequency_value >= max(_figures(K, p)[0] for p in corners)
     seats, _ = occ.sample(200, np.random.default_rng(2026))
     sampled = max(_figures(K, p)[0] for p in seats)
     assert u.value > 1.05 * sampled          # 1777 N against 1559 N on 2026-11-28
@@ -70,11 +71,13 @@ def test_climb_finds_the_stroke_between_corners(K, found):
     corners = [occ.at({r[0]: r[1 + b] for r, b in zip(ranges, c)})
                for c in product((0, 1), repeat=7)]
     best_corner = max(_figures(K, p)[1] for p in corners)
-    assert x1.value > best_corner            # 0.06983 m against 0.06965 m
+    assert x1.frequency_value > best_corner   # 0.06983 m against 0.06965 m
     lo, hi = ranges[1][1:]
     scan = [_figures(K, replace(x1.seat, k1=float(k)))[1]
             for k in np.linspace(lo, hi, 41)]
-    assert x1.value >= max(scan) * (1 - 1e-6)
+    # where a climb on a kinked surface stops depends on roundoff: 1e-3 is ten times the
+    # largest difference between scan neighbours near the peak (measured 2026-11-28)
+    assert x1.frequency_value >= max(scan) * (1 - 1e-3)
     assert lo < x1.seat.k1 < hi
 
 
@@ -90,6 +93,31 @@ def test_a_seat_where_the_loop_is_unstable_is_found():
     assert u.describe().startswith("unstable at m3")
 
 
+def test_an_instability_at_the_longer_delays_names_the_first_unstable_delay():
+    """A stiff static gain (60 kN/m on x1): the nominal loop is stable up to 28 ms, a
+    seat with soft c1 only up to 20 ms (the delay margin, computed here by its own
+    routine).  The search reports inf at the first delay where its seat's loop is
+    unstable, the one before it stable."""
+    from lmi_suspension.seat.refine import REFINE_DELAYS
+    from lmi_suspension.seat.simulate import closed_loop_stable, stability_delay_margin
+
+    stiff = control.ss([], [], [], [[60000.0, 0.0]])
+    assert stability_delay_margin(stiff) > REFINE_DELAYS[-1]
+    u, x1 = worst_bump_seats(stiff, rng=np.random.default_rng(0), n=0, starts=1)
+    assert u.value == x1.value == np.inf and np.isnan(u.frequency_value)
+    k = REFINE_DELAYS.index(u.delay)
+    assert k > 0 and not closed_loop_stable(stiff, u.delay, u.seat)
+    assert closed_loop_stable(stiff, REFINE_DELAYS[k - 1], u.seat)
+    assert REFINE_DELAYS[k - 1] < stability_delay_margin(stiff, u.seat) <= u.delay
+
+
+def test_a_fixed_mass_is_the_searched_mass():
+    heavy = OccupantSet(m3=(70.0, 70.0), damping_rel=0.0)
+    u, x1 = worst_bump_seats(control.ss([], [], [], [[0.0, 0.0]]), heavy,
+                             rng=np.random.default_rng(0), n=0, starts=0, delays=0.0)
+    assert u.seat.m3 == x1.seat.m3 == 70.0 and u.evaluations == 8   # k1..k3 corners
+
+
 def test_the_passive_seat_commands_nothing_and_a_fixed_set_is_one_seat():
     passive = control.ss([], [], [], [[0.0, 0.0]])
     fixed = OccupantSet(m3=(43.3, 43.3), stiffness_rel=0.0, damping_rel=0.0)
@@ -100,8 +128,9 @@ def test_the_passive_seat_commands_nothing_and_a_fixed_set_is_one_seat():
 
 
 @pytest.mark.parametrize("kwargs", [dict(rng=0), dict(n=-1), dict(starts=1.5),
-                                    dict(delays=(np.nan,)), dict(occupants="set"),
-                                    dict(road="bump"), dict(K="K")])
+                                    dict(delays=(np.nan,)), dict(delays=()),
+                                    dict(occupants="set"), dict(road="bump"), dict(K="K"),
+                                    dict(K=control.ss([], [], [], [[np.nan, 0.0]]))])
 def test_bad_input_raises(kwargs):
     args = dict(K=control.ss([], [], [], [[0.0, 0.0]]), rng=np.random.default_rng(0))
     args.update(kwargs)
@@ -115,7 +144,9 @@ def test_a_discrete_controller_is_refused():
                          rng=np.random.default_rng(0))
 
 
-def test_worst_seat_describes_where():
-    w = WorstSeat(figure="u", value=1600.0, seat=SeatParameters(), delay=0.025,
+def test_worst_seat_describes_where_and_knows_its_figures():
+    w = WorstSeat(figure="u", value=1500.4, seat=SeatParameters(), delay=0.025,
                   evaluations=1)
-    assert w.describe().startswith("1600 N at m3 43.3 kg") and w.describe().endswith("25 ms")
+    assert w.describe().startswith("1500.4 N at m3 43.3 kg") and w.describe().endswith("25 ms")
+    with pytest.raises(ParameterError, match="figure"):
+        WorstSeat(figure="z", value=1.0, seat=SeatParameters(), delay=0.0, evaluations=1)

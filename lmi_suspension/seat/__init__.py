@@ -7,8 +7,9 @@ force and stroke bounds in the K-step), :mod:`.refine` (the µ controller refine
 exact bump requirements), :mod:`.multimodel` (that refinement over a set of seats, with
 a worst-case search), :mod:`.bounded` (H∞ with peak bounds) and :mod:`.sampled` (the
 1 kHz implementation); :mod:`.occupants` is the set of seats a controller must serve and
-its certificate over them, :mod:`.worstcase` the search for its worst seats.  :mod:`.routes` is the one entry to them all
-(:func:`design_seat`, :class:`SeatDesign`, :func:`certify_seat`).
+its certificate over them, :mod:`.worstcase` the search for its worst seats.
+:mod:`.routes` is the one entry to them all (:func:`design_seat`, :class:`SeatDesign`,
+:func:`certify_seat`).
 """
 
 from .augmented import BUMP_PEAK_VELOCITY, SeatAugmentedPlant, SeatDesignOptions, seat_augmented_plant
@@ -26,7 +27,8 @@ from .bounded import PeakBoundedDesign, design_peak_bounded, road_energy
 # the designs' own modules, documented as modules: the µ design, its constrained K-step
 # route, the refinement (on one seat and on a set), the set of seats and its certificate,
 # and the sampled-data implementation
-from . import constrained, design, multimodel, occupants, refine, routes, sampled, worstcase
+from . import (constrained, design, multimodel, occupants, refine, routes, sampled,
+               worstcase)
 # one entry for every route: design_seat, the SeatDesign it returns, certify_seat
 from .routes import (SeatCertificate, SeatDesign, SeatRequirements, SeatRoute, certify_seat,
                      design_seat, load_seat_design, save_seat_design)

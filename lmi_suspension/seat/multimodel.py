@@ -14,8 +14,8 @@ the result, and the set's corners and a climb from the worst of them look for th
 largest force and stroke (:func:`~.worstcase.worst_bump_seats`: samples rarely come near
 a corner, where the force peaks); the seats that violate a requirement, or whose ratio
 exceeds the rounds' worst over its seats, are added (at most ``add`` per round,
-violations first, the worst first), and the next round starts from the result.  The loop ends when a search finds nothing to add,
-finds a seat where the loop is unstable (reported, not added: a refinement starts from a
+violations first, the worst first), and the next round starts from the result.  The
+loop ends when a search finds nothing to add, finds a seat where the loop is unstable (reported, not added: a refinement starts from a
 loop that is stable at every seat it serves), or after ``rounds`` rounds.
 
 The answer is certified by :func:`~.occupants.certify_occupants` on samples the search
@@ -72,11 +72,13 @@ class OccupantRound:
     worst_found : float
         The largest ratio (peak over own limit) among the search samples.
     violations_found : int
-        Search samples that violate force, stroke or stability.
+        Search samples, and worst seats of the corner search (``worst_seats``), that
+        violate force, stroke or stability.
     added : tuple of SeatParameters
         The seats added for the next round.
     unstable : tuple of SeatParameters
-        Search samples whose loop is unstable with the round's controller.  They are
+        Search samples and corner-search seats whose loop is unstable with the round's
+        controller.  They are
         not added: a refinement starts from a controller whose loop is stable at every
         seat it serves.  The loop stops after a round that finds one (a user decides:
         another start, a smaller set).
@@ -138,17 +140,21 @@ def _search(K, seats, opts: RefineOptions, road: RoadInput) -> list:
 
 
 def _corner_search(K, occupants: OccupantSet, opts: RefineOptions, road: RoadInput,
-                   rng: np.random.Generator) -> tuple[tuple, list]:
+                   rng: np.random.Generator, plants) -> tuple[tuple, list]:
     """The set's largest force and stroke over its corners and a climb
     (:func:`~.worstcase.worst_bump_seats`, no samples: ``_search`` has met them), and
     ``(violation, nan, seat)`` for each that exceeds its bound: violations rank by their
-    excess, so the seat's ratio is not needed."""
+    excess, so the seat's ratio is not needed.  The excess is the frequency-domain
+    figure's, the one the refinement bounds at its seats and ``_search`` reads, so that
+    a seat the refinement serves is never a violation here; such a seat is not added
+    again in any case."""
     worst_seats = worst_bump_seats(K, occupants, rng=rng, n=0, delays=opts.delays,
                                    road=road)
     violations = []
     for w in worst_seats:
-        excess = w.value / (opts.u_bound if w.figure == "u" else opts.z_bound) - 1
-        if excess > 0:
+        figure = w.value if w.value == math.inf else w.frequency_value
+        excess = figure / (opts.u_bound if w.figure == "u" else opts.z_bound) - 1
+        if excess > 0 and w.seat not in plants:
             violations.append((excess, math.nan, w.seat))
     return worst_seats, violations
 
@@ -208,7 +214,8 @@ def refine_for_occupants(K0, occupants: OccupantSet | None = None,
         seats, _ = occupants.sample(n_search, rng)
         found = _search(K, seats, opts, road)
         worst_found = max(f[1] for f in found)
-        worst_seats, violations = _corner_search(K, occupants, opts, road, rng)
+        worst_seats, violations = _corner_search(K, occupants, opts, road, rng,
+                                                 (occupants.nominal, *plants))
         found = list(found) + violations
         worst = float(np.max(d.peak))
         unstable = tuple(p for v, _, p in found if v == np.inf)
