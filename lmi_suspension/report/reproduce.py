@@ -425,7 +425,10 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     set, at the map's own delays
     (0 and 25 ms whatever ``delays``; 25 ms with ``quick``), each cell's peak over its
     own physical limit and its exact-delay stability, with the worst seat in the set
-    replayed for its figure.
+    replayed for its figure; and, in the set's seven parameters, the seats where its
+    commanded force and stroke on the bump are largest, found by
+    :func:`~lmi_suspension.seat.worstcase.worst_bump_seats` at the run's delays (the
+    summary's ``occupant_map["searched"]``; a requirement missed there is a fact).
 
     Files written: ``fig07_bump.png`` … ``fig15_mu_bounds.png`` (the paper's figures),
     ``peak_vs_delay.png``, ``iso_C_z3dd.png``, ``summary.json`` (non-finite numbers are
@@ -449,7 +452,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     shipped one is loaded and re-certified here (µ bounds, worst-case force and stroke,
     poles), and simulated like the others, also as its 1 kHz sampled-data loop; so are the
     refined controller (``mu_refined``) and the controller for every occupant
-    (``mu_occupants``, a search of about 15 minutes).
+    (``mu_occupants``, four refinement rounds of 8 to 14 minutes each).
 
     Parameters
     ----------

@@ -47,11 +47,12 @@ __all__ = ["OccupantRound", "OccupantDesign", "OccupantRoute", "SHIPPED_OCCUPANT
 
 logger = logging.getLogger(__name__)
 
-#: the multi-seat design of 2026-11-27 with the set's mixed µ as a requirement (its
-#: metadata says how it was made; read it with :func:`~.refine.load_refined`): mixed µ of
-#: robust stability 0.980 over every frequency, stable on 10 000 sampled seats, at most
-#: 1559 N and 2.60 × each seat's own limit on 200 (the note of issue 38), not yet the
-#: issue's comfort targets
+#: the multi-seat design of 2026-11-28 with the set's mixed µ as a requirement, refined
+#: at the corners where :func:`~.worstcase.worst_bump_seats` found the force above 1500 N
+#: (its metadata's ``made`` says how; read it with :func:`~.refine.load_refined`): mixed
+#: µ of robust stability 0.987 over every frequency, stable on 10 000 sampled seats,
+#: 1497 N at the set's worst seat found, 2.88 × each seat's own limit at worst on 200
+#: (the note of issue 38), not yet the issue's comfort targets
 SHIPPED_OCCUPANTS = Path(__file__).parent / "data" / "mu_occupants.json"
 
 #: a search sample joins the seats when its ratio exceeds the round's worst by more than

@@ -389,7 +389,7 @@ class SeatCertificate:
                            f"set, searched: the loop is {w.describe()}")
         if self.mixed_mu is not None and not self.mixed_mu.rs_sup < 1.0:
             out.append(f"set: robust-stability mixed µ {self.mixed_mu.rs_sup:.4f}, not below 1")
-        return tuple(out)
+        return tuple(dict.fromkeys(out))      # one unstable seat found for both figures: once
 
     @property
     def met(self) -> bool:
