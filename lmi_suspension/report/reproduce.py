@@ -953,8 +953,9 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
 
 
 def _searched_worst(K, params, delays, cfg: _Settings, seed: int) -> dict:
-    """The exported controller's largest commanded force and stroke over its set, by
-    search (:func:`~lmi_suspension.seat.worstcase.worst_bump_seats`): the summary's
+    """The exported controller's largest commanded force and stroke over the set around
+    the nominal seat (:class:`~lmi_suspension.seat.occupants.OccupantSet`), by search
+    (:func:`~lmi_suspension.seat.worstcase.worst_bump_seats`): the summary's
     ``occupant_map["searched"]``, one entry per figure."""
     from ..seat.occupants import OccupantSet
     from ..seat.worstcase import worst_bump_seats

@@ -15,8 +15,9 @@ largest force and stroke (:func:`~.worstcase.worst_bump_seats`: samples rarely c
 a corner, where the force peaks); the seats that violate a requirement, or whose ratio
 exceeds the rounds' worst over its seats, are added (at most ``add`` per round,
 violations first, the worst first), and the next round starts from the result.  The
-loop ends when a search finds nothing to add, finds a seat where the loop is unstable (reported, not added: a refinement starts from a
-loop that is stable at every seat it serves), or after ``rounds`` rounds.
+loop ends when a search finds nothing to add, finds a seat where the loop is unstable
+(reported, not added: a refinement starts from a loop that is stable at every seat it
+serves), or after ``rounds`` rounds.
 
 The answer is certified by :func:`~.occupants.certify_occupants` on samples the search
 did not draw and by :func:`~.occupants.occupant_mu`.
@@ -79,10 +80,9 @@ class OccupantRound:
         The seats added for the next round.
     unstable : tuple of SeatParameters
         Search samples and corner-search seats whose loop is unstable with the round's
-        controller.  They are
-        not added: a refinement starts from a controller whose loop is stable at every
-        seat it serves.  The loop stops after a round that finds one (a user decides:
-        another start, a smaller set).
+        controller.  They are not added: a refinement starts from a controller whose
+        loop is stable at every seat it serves.  The loop stops after a round that
+        finds one (a user decides: another start, a smaller set).
     seconds : float
     worst_seats : tuple of WorstSeat
         The largest force and stroke found over the set's corners and a climb.

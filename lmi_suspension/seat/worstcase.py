@@ -57,8 +57,9 @@ _CLIMB_EVALUATIONS = 80
 #: 40 kg mass range by 4 g: the figures' FFT noise is far below the change)
 _CLIMB_STEP = 1e-4
 #: what a climb's objective reads at an unstable seat (the figures are divided by the
-#: start's, so a stable seat reads about -1): finite, so L-BFGS-B's line search backs
-#: off instead of aborting; the seat itself stays a finding (inf) in the search's record
+#: start's, so a stable seat reads about -1): below every stable seat, as an instability
+#: is worse than any force, but finite (at -inf L-BFGS-B stops with an ABNORMAL status
+#: and a nan gradient); the seat itself stays a finding (inf) in the search's record
 _UNSTABLE_PENALTY = -1e3
 #: the frequency-domain and time-stepping figures of a seat agree to 0.1-0.5 % on the
 #: shipped designs (2026-11-28); beyond this, a warning says which one the value is
