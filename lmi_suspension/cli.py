@@ -319,13 +319,8 @@ def _cmd_occupants(args: argparse.Namespace) -> int:
                      f"({m.rp_lower:5.3f})")
         sys.stdout.write(line + "\n")
         for w in cert.worst_seats:
-            row[f"searched_{w.figure}"] = dict(
-                value=w.value if math.isfinite(w.value) else None,   # null: unstable
-                delay=w.delay, evaluations=w.evaluations,
-                seat={k: getattr(w.seat, k) for k in ("m3", "k1", "k2", "k3", "c1", "c2",
-                                                      "c3")})
-            sys.stdout.write(f"{'':>14} searched {'|u|' if w.figure == 'u' else '|x1|'}: "
-                             f"{w.describe()}\n")
+            row[f"searched_{w.figure}"] = w.as_dict()        # value null: unstable
+            sys.stdout.write(f"{'':>14} searched {w.label.split()[-1]}: {w.describe()}\n")
         failures = cert.failures()
         row["requirements_not_met"] = list(failures)
         verdicts.append(f"{name}: " + ("all met" if not failures else "; ".join(failures)))

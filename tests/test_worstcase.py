@@ -7,6 +7,7 @@ The controller is the multi-seat design shipped on 2026-11-27 (kept as
 ``tests/data/multiseat_v2.json``): on 200 Latin-hypercube samples it asks 1559 N at
 most (the note of issue 38), at the set's corner 30 kg, springs stiff, 1777 N."""
 
+import json
 from dataclasses import replace
 from itertools import product
 from pathlib import Path
@@ -148,5 +149,13 @@ def test_worst_seat_describes_where_and_knows_its_figures():
     w = WorstSeat(figure="u", value=1500.4, seat=SeatParameters(), delay=0.025,
                   evaluations=1)
     assert w.describe().startswith("1500.4 N at m3 43.3 kg") and w.describe().endswith("25 ms")
+    d = w.as_dict()
+    assert d["value"] == 1500.4 and d["label"] == "commanded |u|" and d["text"] == w.describe()
+    assert d["seat"]["m3"] == 43.3 and d["frequency_value"] is None
+    assert json.loads(json.dumps(d, allow_nan=False)) == d
+    gone = WorstSeat(figure="x1", value=np.inf, seat=SeatParameters(), delay=0.0,
+                     evaluations=1).as_dict()
+    assert gone["value"] is None and gone["label"] == "|x1|"
+    assert gone["text"].startswith("unstable at")
     with pytest.raises(ParameterError, match="figure"):
         WorstSeat(figure="z", value=1.0, seat=SeatParameters(), delay=0.0, evaluations=1)

@@ -783,7 +783,8 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         + _map_worst_text(map_data["worst_in_set"]))
     # the set's corners, where the force peaks and which the map's plane does not reach
     tok = stage("worst_seats", "the set's largest force and stroke, by search ...")
-    map_data["searched"] = _searched_worst(K_export, params, delays, cfg, search_seed)
+    searched = _searched_worst(K_export, params, delays, cfg, search_seed)
+    map_data["searched"] = {w.figure: w.as_dict() for w in searched}
     done(tok)
     say("  " + _searched_text(map_data["searched"]))
 
@@ -895,15 +896,13 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     if exported != EXPORTED:
         facts += (f"controller.json holds the {_LONG_NAMES[exported]} design: "
                   f"{_LONG_NAMES[EXPORTED]} failed ({errors.get(EXPORTED, 'not loaded')})",)
-    over = [w for w in map_data["searched"].values()
-            if not w["value"] <= {"u": params.u_max, "x1": params.z_max}[w["figure"]]]
+    over = [w for w in searched
+            if not w.value <= {"u": params.u_max, "x1": params.z_max}[w.figure]]
     if over:
-        names = {"u": "commanded |u|", "x1": "|x1|"}
         facts += ("controller.json misses a requirement at a seat of the set around the "
                   "nominal seat (found by search): "
-                  + "; ".join(f"{names[w['figure']]} " + (
-                      w["text"] if w["value"] != math.inf else f"(the loop is {w['text']})")
-                      for w in over),)
+                  + "; ".join(f"{w.label} {w.describe()}" if w.value != math.inf
+                              else f"{w.label} (the loop is {w.describe()})" for w in over),)
     if map_data["failed_cells"] or map_data["cells_in_set_without_limit"]:
         facts += (f"occupant map: {map_data['failed_cells']} cells raised (occupant_map/"
                   f"results.parquet has the errors) and {map_data['cells_in_set_without_limit']}"
@@ -952,28 +951,21 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                             timings=dict(timings), data=data, facts=facts)
 
 
-def _searched_worst(K, params, delays, cfg: _Settings, seed: int) -> dict:
+def _searched_worst(K, params, delays, cfg: _Settings, seed: int) -> tuple:
     """The exported controller's largest commanded force and stroke over the set around
     the nominal seat (:class:`~lmi_suspension.seat.occupants.OccupantSet`), by search
-    (:func:`~lmi_suspension.seat.worstcase.worst_bump_seats`): the summary's
-    ``occupant_map["searched"]``, one entry per figure."""
+    (:func:`~lmi_suspension.seat.worstcase.worst_bump_seats`)."""
     from ..seat.occupants import OccupantSet
     from ..seat.worstcase import worst_bump_seats
 
-    found = worst_bump_seats(K, OccupantSet(nominal=params), rng=np.random.default_rng(seed),
-                             n=cfg.search_n, starts=cfg.search_starts, delays=delays)
-    return {w.figure: {"figure": w.figure, "value": w.value, "delay": w.delay,
-                       "seat": {k: getattr(w.seat, k) for k in
-                                ("m3", "k1", "k2", "k3", "c1", "c2", "c3")},
-                       "evaluations": w.evaluations, "text": w.describe()}
-            for w in found}
+    return worst_bump_seats(K, OccupantSet(nominal=params), rng=np.random.default_rng(seed),
+                            n=cfg.search_n, starts=cfg.search_starts, delays=delays)
 
 
 def _searched_text(searched: Mapping) -> str:
-    """The search's worst force and stroke, in one phrase."""
-    names = {"u": "commanded |u|", "x1": "|x1|"}
+    """The search's worst force and stroke (the summary's entries), in one phrase."""
     return ("largest over the set by search: "
-            + "; ".join(f"{names[k]} {w['text']}" for k, w in searched.items()))
+            + "; ".join(f"{w['label']} {w['text']}" for w in searched.values()))
 
 
 def _map_worst_text(worst: Mapping | None) -> str:

@@ -383,8 +383,7 @@ class SeatCertificate:
         for w in self.worst_seats:
             bound = {"u": r.u_max, "x1": r.z_max}[w.figure]
             if not w.value <= bound:
-                what = {"u": "commanded |u|", "x1": "|x1|"}[w.figure]
-                out.append(f"set, searched: {what} {w.describe()}, above {bound:g}"
+                out.append(f"set, searched: {w.label} {w.describe()}, above {bound:g}"
                            if w.value != math.inf else
                            f"set, searched: the loop is {w.describe()}")
         if self.mixed_mu is not None and not self.mixed_mu.rs_sup < 1.0:

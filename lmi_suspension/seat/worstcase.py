@@ -65,6 +65,8 @@ _UNSTABLE_PENALTY = -1e3
 #: shipped designs (2026-11-28); beyond this, a warning says which one the value is
 _AGREEMENT = 0.01
 _FIGURES = ("u", "x1")
+#: the parameters an :class:`~.occupants.OccupantSet` ranges over
+_PARAMETERS = ("m3", "k1", "k2", "k3", "c1", "c2", "c3")
 
 
 @dataclass(frozen=True)
@@ -109,12 +111,28 @@ class WorstSeat:
                 f"c1 {s.c1:.0f}, c2 {s.c2:.0f}, c3 {s.c3:.0f} N s/m, "
                 f"{self.delay * 1e3:.0f} ms")
 
+    @property
+    def label(self) -> str:
+        """The figure's name in a sentence: ``commanded |u|`` or ``|x1|``."""
+        return {"u": "commanded |u|", "x1": "|x1|"}[self.figure]
+
     def describe(self) -> str:
         """One line: the value and where it is attained."""
         if self.value == math.inf:
             return f"unstable at {self.where}"
         value = (f"{self.value:.1f} N" if self.figure == "u" else f"{self.value:.5f} m")
         return f"{value} at {self.where}"
+
+    def as_dict(self) -> dict:
+        """Plain JSON values (``value`` null where the loop is unstable), the seat's
+        uncertain parameters by name, and :meth:`describe`'s line as ``text``."""
+        return {"figure": self.figure, "label": self.label,
+                "value": self.value if math.isfinite(self.value) else None,
+                "delay": self.delay, "evaluations": self.evaluations,
+                "frequency_value": (self.frequency_value
+                                    if math.isfinite(self.frequency_value) else None),
+                "seat": {k: getattr(self.seat, k) for k in _PARAMETERS},
+                "text": self.describe()}
 
 
 def worst_bump_seats(K, occupants: OccupantSet | None = None, *, rng: np.random.Generator,
