@@ -14,7 +14,7 @@ from matplotlib.ticker import NullFormatter
 
 __all__ = ["plot_bounded_response", "plot_commanded_force", "plot_constrained_tradeoff",
            "plot_force_tradeoff", "plot_mu_bounds", "plot_peak_vs_delay", "plot_responses",
-           "plot_occupants", "plot_road"]
+           "plot_occupants", "plot_occupant_tradeoff", "plot_road"]
 
 _LABELS = {
     "z3dd": ("upper-body acceleration $\\ddot z_3$", "m/s²"),
@@ -411,4 +411,76 @@ def plot_occupants(check, samples, *, x: str = "m3", y: str = "k1", title: str =
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=7, loc="best")
     ax.set_title(title)
+    return fig
+
+
+def plot_occupant_tradeoff(points: Sequence, *, worst_goal: float = 1.5,
+                           nominal_goal: float = 1.3, u_actuator: float = 1500.0,
+                           x1_bound: float = 0.08, title: str = "") -> Figure:
+    """What the force bound costs a controller for every seat of a set (issue 38): left,
+    the worst and the nominal seat's peak ``|z̈3|`` over their own limits against the
+    largest commanded force found over the set, with the goals; then that force and the
+    stroke found by search and on the samples, against the design's force bound.
+
+    Parameters
+    ----------
+    points : sequence of OccupantTradeoffPoint
+        From :func:`~lmi_suspension.seat.multimodel.load_occupant_tradeoff` (anything
+        with ``u_bound``, ``worst_ratio``, ``nominal_ratio``, ``u_samples``,
+        ``u_searched``, ``x1_samples`` and ``x1_searched``).
+    worst_goal, nominal_goal : float
+        The goals, as multiples of each seat's own limit.
+    u_actuator, x1_bound : float
+        The actuator's force limit (N) and the stroke's bound (m).
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as P
+    >>> pts = [P(u_bound=1500.0, worst_ratio=2.9, nominal_ratio=2.3, u_samples=1463.0,
+    ...          u_searched=1497.0, x1_samples=0.064, x1_searched=0.073),
+    ...        P(u_bound=2000.0, worst_ratio=1.8, nominal_ratio=1.4, u_samples=2036.0,
+    ...          u_searched=2200.0, x1_samples=0.078, x1_searched=0.079)]
+    >>> fig = plot_occupant_tradeoff(pts)
+    >>> [len(ax.lines) for ax in fig.axes]
+    [5, 4, 3]
+    """
+    pts = sorted(points, key=lambda p: p.u_bound)
+    bound = np.array([p.u_bound for p in pts])
+    searched = np.array([p.u_searched for p in pts])
+    fig = Figure(figsize=(13, 4), layout="constrained")
+    a1, a2, a3 = fig.subplots(1, 3, width_ratios=(1.4, 1, 1))
+    a1.plot(searched, [p.worst_ratio for p in pts], "o-", color="C0",
+            label="worst seat of the samples, 0–25 ms")
+    a1.plot(searched, [p.nominal_ratio for p in pts], "s-", color="C2",
+            label="nominal seat, 0–25 ms")
+    for p, x, y in zip(pts, searched, [p.worst_ratio for p in pts]):
+        a1.annotate(f"bound {p.u_bound:g} N", (x, y), textcoords="offset points",
+                    xytext=(4, 4), fontsize=8)
+    a1.axhline(worst_goal, color="C0", ls="--", lw=1, label=f"goal at worst {worst_goal:g} ×")
+    a1.axhline(nominal_goal, color="C2", ls="--", lw=1,
+               label=f"goal at the nominal seat {nominal_goal:g} ×")
+    a1.axvline(u_actuator, color="C3", ls=":", label=f"actuator {u_actuator:g} N")
+    a1.set_xlabel("largest commanded $|u|$ found over the set (search) [N]")
+    a1.set_ylabel("peak $|\\ddot z_3|$ / that seat's own limit")
+    a1.set_ylim(1.0, 1.1 * max(max(p.worst_ratio for p in pts), worst_goal))
+    a1.legend(fontsize=8)
+    a2.plot(bound, searched, "o-", color="C3", label="largest $|u|$ found by search")
+    a2.plot(bound, [p.u_samples for p in pts], "o--", mfc="none", color="C3",
+            label="largest $|u|$ on the samples")
+    a2.plot(bound, bound, color="k", lw=1, label="bound")
+    a2.axhline(u_actuator, color="C3", ls=":", lw=1, label=f"actuator {u_actuator:g} N")
+    a2.set_ylabel("force [N]")
+    a3.plot(bound, [p.x1_searched for p in pts], "^-", color="C4",
+            label="largest $|x_1|$ found by search")
+    a3.plot(bound, [p.x1_samples for p in pts], "^--", mfc="none", color="C4",
+            label="largest $|x_1|$ on the samples")
+    a3.axhline(x1_bound, color="k", lw=1, label=f"stroke bound {x1_bound:g} m")
+    a3.set_ylim(0, 1.15 * x1_bound)
+    a3.set_ylabel("stroke $|x_1|$ [m]")
+    for ax in (a2, a3):
+        ax.set_xlabel("force bound of the design (at its seats) [N]")
+        ax.legend(fontsize=8, loc="lower right")
+    for ax in (a1, a2, a3):
+        ax.grid(True, alpha=0.3)
+    fig.suptitle(title)
     return fig

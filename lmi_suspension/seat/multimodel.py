@@ -30,7 +30,7 @@ import math
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Callable, ClassVar
+from typing import Callable, ClassVar, Mapping
 
 import control
 import numpy as np
@@ -44,6 +44,7 @@ from .roads import RoadInput, bump
 from .worstcase import worst_bump_seats
 
 __all__ = ["OccupantRound", "OccupantDesign", "OccupantRoute", "SHIPPED_OCCUPANTS",
+           "SHIPPED_OCCUPANT_TRADEOFF", "OccupantTradeoffPoint", "load_occupant_tradeoff",
            "refine_for_occupants"]
 
 logger = logging.getLogger(__name__)
@@ -55,6 +56,11 @@ logger = logging.getLogger(__name__)
 #: 1497 N at the set's worst seat found, 2.88 × each seat's own limit at worst on 200
 #: (the note of issue 38), not yet the issue's comfort targets
 SHIPPED_OCCUPANTS = Path(__file__).parent / "data" / "mu_occupants.json"
+
+#: the trade-off of the force bound over the set: designs of this route at higher bounds,
+#: each measured on the set with its corners searched (read by
+#: :func:`load_occupant_tradeoff`; the designs ship beside it)
+SHIPPED_OCCUPANT_TRADEOFF = Path(__file__).parent / "data" / "tradeoff_occupants.json"
 
 #: a search sample joins the seats when its ratio exceeds the round's worst by more than
 #: this fraction (below it, the FFT's and the search's own margins decide, not the seat)
@@ -322,3 +328,83 @@ class OccupantRoute:
                                 seconds=d.seconds, detail=d,
                                 description=_description(d.design),
                                 figures={**_figures(d.design), "rounds": len(d.rounds)})
+
+
+@dataclass(frozen=True)
+class OccupantTradeoffPoint:
+    """One design of the force bound's trade-off over the set, as ``lmi-suspension
+    occupants FILE --mu`` measured it.
+
+    Attributes
+    ----------
+    u_bound : float
+        The force bound the design held at its seats, N.
+    design : str
+        Its file (a name beside the table, or a path).
+    unstable, n_stability : int
+        Sampled seats (with delays) where the loop is unstable, of how many.
+    worst_ratio, nominal_ratio : float
+        Peak ``|z̈3|`` on the bump over each seat's own limit: the worst over the
+        performance samples and delays, and at the nominal seat.
+    u_samples, x1_samples : float
+        The largest commanded force (N) and stroke (m) on those samples.
+    searched_u, searched_x1 : mapping
+        :meth:`~.worstcase.WorstSeat.as_dict` of the set's worst force and stroke found by
+        :func:`~.worstcase.worst_bump_seats` (``value``, ``delay``, ``seat``).
+    rs_mu, rp_mu : float
+        Mixed µ of robust stability and of robust performance over the set, bounded
+        between the grid's points (:func:`~.occupants.occupant_mu`).
+    """
+
+    u_bound: float
+    design: str
+    unstable: int
+    n_stability: int
+    worst_ratio: float
+    nominal_ratio: float
+    u_samples: float
+    x1_samples: float
+    searched_u: Mapping
+    searched_x1: Mapping
+    rs_mu: float
+    rp_mu: float
+
+    @property
+    def u_searched(self) -> float:
+        """The largest commanded force found over the set, N."""
+        return float(self.searched_u["value"])
+
+    @property
+    def x1_searched(self) -> float:
+        """The largest stroke found over the set, m."""
+        return float(self.searched_x1["value"])
+
+
+def load_occupant_tradeoff(path=None) -> tuple[tuple[OccupantTradeoffPoint, ...], dict]:
+    """The force bound's trade-off of the occupant route over the set: ``(points, table)``,
+    the points by rising ``u_bound`` (the shipped measurement by default:
+    :data:`SHIPPED_OCCUPANT_TRADEOFF`).  ``table["command"]`` measured them and
+    ``table["made"]`` says how the designs were made; a point's design file is read by
+    :func:`~.routes.load_seat_design` (relative names beside the table).  Plot with
+    :func:`~lmi_suspension.report.figures.plot_occupant_tradeoff`.
+
+    Examples
+    --------
+    >>> points, table = load_occupant_tradeoff()
+    >>> [p.u_bound for p in points]
+    [1500.0, 1750.0, 2000.0]
+    >>> all(p.unstable == 0 for p in points)
+    True
+    """
+    import json
+
+    path = Path(SHIPPED_OCCUPANT_TRADEOFF if path is None else path)
+    table = json.loads(path.read_text())
+    fields = set(OccupantTradeoffPoint.__dataclass_fields__)
+    points = []
+    for p in table["points"]:
+        design = Path(p["design"])
+        point = OccupantTradeoffPoint(**{k: v for k, v in p.items() if k in fields})
+        points.append(replace(point, design=str(design if design.is_absolute()
+                                                 else path.parent / design)))
+    return tuple(sorted(points, key=lambda q: q.u_bound)), table
