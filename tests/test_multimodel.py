@@ -171,7 +171,8 @@ def test_the_force_bounds_trade_off_is_what_its_designs_do():
     from lmi_suspension.seat.worstcase import worst_bump_seats
 
     points, table = load_occupant_tradeoff()
-    assert [p.u_bound for p in points] == sorted(p.u_bound for p in points)
+    # the table is written by rising bound, as the loader returns it
+    assert [p["u_bound"] for p in table["points"]] == [p.u_bound for p in points]
     assert table["command"].startswith("lmi-suspension occupants")
     assert points[0].u_bound == 1500.0
     assert Path(points[0].design).resolve() == SHIPPED_OCCUPANTS.resolve()
@@ -188,4 +189,31 @@ def test_the_force_bounds_trade_off_is_what_its_designs_do():
         assert np.isfinite(corners_u.value)
         assert corners_u.value <= p.u_searched * (1 + 0.01)
     fig = plot_occupant_tradeoff(points)
-    assert len(fig.axes[0].lines[0].get_xdata()) == len(points)
+    assert list(fig.axes[0].lines[0].get_xdata()) == [p.u_searched for p in points]
+    assert list(fig.axes[0].lines[0].get_ydata()) == [p.worst_ratio for p in points]
+
+
+def test_the_trade_off_table_is_read_wherever_it_lies(tmp_path, monkeypatch):
+    """A table elsewhere names its designs beside itself or by absolute path, whatever the
+    working directory; a point that lacks a field is a typed error, not a TypeError."""
+    import json
+
+    from lmi_suspension.seat.multimodel import (SHIPPED_OCCUPANT_TRADEOFF, SHIPPED_OCCUPANTS,
+                                                load_occupant_tradeoff)
+
+    table = json.loads(SHIPPED_OCCUPANT_TRADEOFF.read_text())
+    table["points"] = table["points"][:2]
+    table["points"][0]["design"] = str(SHIPPED_OCCUPANTS)          # absolute
+    table["points"][1]["design"] = "u1750.json"                    # beside the table
+    (tmp_path / "t.json").write_text(json.dumps(table))
+    monkeypatch.chdir(tmp_path.parent)
+    points, _ = load_occupant_tradeoff(Path(tmp_path.name) / "t.json")
+    monkeypatch.chdir(SHIPPED_OCCUPANTS.parent.parent)
+    assert points[0].design == str(SHIPPED_OCCUPANTS)
+    assert points[1].design == str(tmp_path.resolve() / "u1750.json")
+    with pytest.raises(TypeError):
+        points[0].searched_u["value"] = 0.0                           # read-only
+    del table["points"][1]["rs_lower"]
+    (tmp_path / "t.json").write_text(json.dumps(table))
+    with pytest.raises(ParameterError, match="point 1 lacks rs_lower"):
+        load_occupant_tradeoff(tmp_path / "t.json")

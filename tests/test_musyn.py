@@ -18,11 +18,24 @@ from lmi_suspension.synthesis.hinfsyn import _hinfsyn
 
 @pytest.fixture(scope="module")
 def distillation_design():
+    """Iteration 1 and the D-scale search from its D-step (which replaces the later
+    D-K iterations where it beats the first)."""
     ex = skogestad_distillation()
     records = []
     omega = np.logspace(-3, 3, 61)  # the book's grid (and dkpy's example of the problem)
     res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=omega,
                 options=MusynOptions(max_iter=6, patience=3, method="best"),
+                callback=records.append)
+    return ex, res, records
+
+
+@pytest.fixture(scope="module")
+def distillation_dk():
+    """D-K iterations alone (no D-scale search), as the book runs them."""
+    ex = skogestad_distillation()
+    records = []
+    res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-3, 3, 61),
+                options=MusynOptions(max_iter=6, patience=3, method="best", dscale_search=0),
                 callback=records.append)
     return ex, res, records
 
@@ -36,7 +49,7 @@ PUBLISHED_MU_ITER2 = 1.0275
 
 
 @pytest.mark.slow
-def test_distillation_reaches_below_one(distillation_design):
+def test_distillation_reaches_below_one(distillation_design, distillation_dk):
     """Skogestad & Postlethwaite (2005), Sec. 8.12.4, Table 8.1 problem.
 
     The first K-step is the plain H∞ problem; iterations 1-2 match the book's script
@@ -51,15 +64,22 @@ def test_distillation_reaches_below_one(distillation_design):
     search got below that (0.968 from the third iterate, 0.979 from the tenth, measured).
     """
     ex, res, _ = distillation_design
-    assert res.history[0].mu_peak == pytest.approx(PUBLISHED_MU_ITER1, rel=0.005)
-    assert res.history[1].mu_peak == pytest.approx(PUBLISHED_MU_ITER2, rel=0.01)
-    dk_steps = [h for h in res.history if h.stage == "dk"]
+    _, dk, _ = distillation_dk
+    assert dk.history[0].mu_peak == pytest.approx(PUBLISHED_MU_ITER1, rel=0.005)
+    assert dk.history[1].mu_peak == pytest.approx(PUBLISHED_MU_ITER2, rel=0.01)
+    assert all(h.stage == "dk" for h in dk.history)
     # 1.0123 measured on 2026-11-24, 1.0157 on 2026-11-25 once the scaled plants were
     # the exact series connections (minreal's realization had let K-steps certify below
     # the µ of their own loop)
-    assert min(h.mu_peak for h in dk_steps) < 1.02
+    assert min(h.mu_peak for h in dk.history) < 1.02
+    # the search starts from iteration 1's D-step, the same in both runs, and ends below
+    # every D-K iterate, so it replaces the iterations after the first
+    assert res.history[0].mu_peak == dk.history[0].mu_peak
     search = res.history[-1]
-    assert search.stage == "dscale_search" and res.best_iteration == search.index
+    assert [h.stage for h in res.history] == ["dk", "dscale_search"]
+    assert res.best_iteration == search.index == 2
+    assert search.mu_peak < min(h.mu_peak for h in dk.history)
+    assert "D-scale search from iteration 1" in res.stop_reason
     assert search.gamma < search.gamma_prev  # below the γ of its starting scalings
     assert res.mu_peak < 1.0  # 0.97-0.98 measured
     # (the dense grid reaches 1e-9 rad/s, where the loop's double-precision response is
@@ -143,15 +163,16 @@ def test_kstep_regression_stops_the_loop():
 
 
 @pytest.mark.slow
-def test_history_and_best_iterate(distillation_design):
-    _, res, records = distillation_design
+@pytest.mark.parametrize("run", ["distillation_design", "distillation_dk"])
+def test_history_and_best_iterate(run, request):
+    _, res, records = request.getfixturevalue(run)
     # the callback saw every record, complete: the very objects of the history
     assert len(records) == len(res.history)
     assert all(a is b for a, b in zip(records, res.history))
+    assert [h.index for h in res.history] == list(range(1, len(res.history) + 1))
     peaks = [h.mu_peak for h in res.history]
     assert res.best_iteration == int(np.argmin(peaks)) + 1
     assert all(h.seconds_k > 0 and h.seconds_d > 0 for h in res.history)
-    assert [h.stage for h in res.history][-1] == "dscale_search"
     assert all(h.stage == "dk" for h in res.history[:-1])
     # For a stable, minimum-phase D fit the certified γ of the scaled loop bounds µ at
     # every frequency, so it is never below the grid peak of the next D-step.
@@ -858,6 +879,38 @@ def test_a_plain_rebuild_is_not_repeated_by_a_restart():
     fresh.step(2, 2, best)
     source, _ = fresh.step(3, 2, step(3))
     assert source is best
+
+
+def test_a_search_that_does_not_beat_the_first_iterate_leaves_dk_to_go_on(monkeypatch):
+    """The D-scale search runs once, from iteration 1's D-step.  Injected: its record
+    reads µ 10 times its own, above iteration 1's.  D-K then runs its iterations as
+    without the search, the search's record follows them (indices still the history's
+    positions), and the returned controller is the best D-K iterate's; with the search
+    left as it is, it replaces iterations 2 and 3."""
+    from lmi_suspension.mu import dk
+
+    real, calls = dk._search_stage, []
+
+    def worse(*args, **kwargs):
+        calls.append(kwargs["index"])
+        found = real(*args, **kwargs)
+        return dataclasses.replace(found, mu_peak=10.0 * found.mu_peak)
+
+    ex = skogestad_distillation()
+    opts = MusynOptions(method="riccati", max_iter=3, patience=3, dscale_search=3)
+    omega = np.logspace(-3, 3, 31)
+    as_is = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=omega, options=opts)
+    monkeypatch.setattr(dk, "_search_stage", worse)
+    res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=omega, options=opts)
+    assert calls == [2]  # once, after iteration 1
+    assert [h.stage for h in res.history] == ["dk"] * 3 + ["dscale_search"]
+    assert [h.index for h in res.history] == [1, 2, 3, 4]
+    assert res.best_iteration == 1 + int(np.argmin([h.mu_peak for h in res.history[:3]]))
+    assert res.stop_reason == "reached max_iter=3"
+    assert [h.stage for h in as_is.history] == ["dk", "dscale_search"]
+    assert as_is.best_iteration == 2 and as_is.history[1].mu_peak < as_is.history[0].mu_peak
+    assert as_is.history[0].mu_peak == res.history[0].mu_peak
+    assert res.history[3].mu_peak == pytest.approx(10.0 * as_is.history[1].mu_peak, rel=1e-9)
 
 
 def test_an_iterate_whose_mu_lower_bound_beats_its_gamma_is_flagged(monkeypatch):

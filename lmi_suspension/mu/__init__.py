@@ -1,7 +1,7 @@
 """Structured singular value µ and µ-synthesis.
 
 block structures -> bounds (``mussv``, over intervals ``interval_bound``) -> rational D-scale fits -> D-K iteration (``musyn``)
--> direct D-scale search (``search_dscales``, run by ``musyn`` after the loop).
+-> direct D-scale search (``search_dscales``, run by ``musyn`` from the first iterate).
 """
 
 from .blocks import Block, BlockKind, BlockStructure

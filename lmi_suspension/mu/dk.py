@@ -13,10 +13,11 @@ a small protocol, built from the run's setup):
 
 The loop owns what compares iterates: the best one (lowest µ peak meeting every
 constraint), patience, the stopping rules, and the certificates of each iterate (its
-closed-loop poles, µ lower bound against its γ, constraints recomputed).  After it, a
-direct search on the D-scale fit parameters with the K-step inside (:mod:`.dsearch`),
-started from the first iterate's D-step, goes on to a local minimum of the bound where
-D-K stalls.  The best iterate is returned, never a worse last one; its µ is certified on
+closed-loop poles, µ lower bound against its γ, constraints recomputed).  After the
+first iterate, a direct search on the D-scale fit parameters with the K-step inside
+(:mod:`.dsearch`), started from that iterate's D-step, goes on to a local minimum of the
+bound where D-K stalls; where it beats the iterate it replaces the later D-K iterations
+(``dscale_search``).  The best iterate is returned, never a worse last one; its µ is certified on
 a dense grid with the true structure (real blocks real), the grid peak refined with the
 LMI bound (:func:`_final_bounds`) and bounded between grid points (``mu_bound``).
 ``MusynOptions(complexify=True)`` covers real blocks by complex discs in the loop.
@@ -91,6 +92,8 @@ class MusynOptions:
     ----------
     max_iter : int
         Largest number of D-K iterations (each = one K-step, one D-step, one D-fit).
+        Where the D-scale search runs and beats the first iterate, there is one
+        (``dscale_search``).
     mu_target : float
         Stop as soon as the µ peak falls below this value (``0`` never stops early).
     patience : int
@@ -170,9 +173,9 @@ class MusynOptions:
         ``musyn`` in 15-26 s with the halving, 18-32 s without, over 4 OpenBLAS kernels
         and 1 and 2 threads; measured 2026-11-26).
     dscale_search : int
-        After the D-K loop, at most this many points (a K-step's level each) of a
-        direct search on the parameters of the D-scale fits (order
-        ``max_dfit_order``), started from the D-step of the *first* iterate: a
+        After the first D-K iterate, at most this many points (a K-step's level each) of
+        a direct search on the parameters of the D-scale fits (order
+        ``max_dfit_order``), started from the D-step of that iterate: a
         descent method for the piecewise-smooth level
         SLICOT's Riccati synthesis achieves on each scaled plant (BFGS on difference
         quotients, least-norm steps at kinks, every accepted point checked by a
@@ -188,8 +191,16 @@ class MusynOptions:
         0.9636-0.9716).  Mostly, not always: on 51- and 71-point grids the Haswell and
         Sandybridge kernels ended in different local minima, 0.2 % and 0.5 % apart
         (measured 2026-11-26).  Blocks whose optimal scalings coincide share one fit.
-        The controller is kept only if its µ peak beats the best iterate's; ``0``
-        turns the search off.  Skipped for constant scalings (``max_dfit_order = 0``),
+        Where its µ peak beats the first iterate's, its controller is kept and the D-K
+        iterations after the first are not run: the search starts from the first
+        iterate's D-step whatever they do, and on distillation they never ended below
+        it (best D-K iterate 0.978-0.983 against 0.9594-0.9595 on 8 kernel rows) while
+        costing 1-15 s of LMI K-steps; D-K continued from the search's controller
+        failed at its first K-step, the LMI finding no controller 0.3 % above SLICOT's
+        level (measured 2026-11-29).  Where the search finds nothing or does not beat
+        the first iterate, D-K goes on as without it, and the search's record follows
+        the loop's.  ``0`` turns the search off, and D-K runs its ``max_iter``
+        iterations.  Skipped for constant scalings (``max_dfit_order = 0``),
         with constraints, and once ``mu_target`` is met; it stops as soon as an
         accepted level is below ``mu_target``.  A level costs 15 (difference
         quotient) to 20 (trial step) syntheses of 3-4 ms on distillation's 22-state
@@ -284,8 +295,8 @@ class MusynIteration:
     K : control.StateSpace or None
         This iteration's controller.
     stage : str
-        ``"dk"`` for a D-K iteration, ``"dscale_search"`` for the direct search after
-        the loop (``seconds_k`` is then its wall time, K-steps and scaled plants,
+        ``"dk"`` for a D-K iteration, ``"dscale_search"`` for the direct search from
+        the first iterate's D-step (``seconds_k`` is then its wall time, K-steps and scaled plants,
         ``seconds_fit`` zero and ``gamma_prev`` its γ at the starting scalings).
     certificates : tuple of SpecificationCertificate
         With ``constraints``: each constraint recomputed on ``F_l(P, K)`` (the plant as
@@ -583,6 +594,7 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
 
     history: list[MusynIteration] = []
     best = None  # (mu_peak, K, index)
+    searched = None  # a D-scale search that did not beat iteration 1
     stop_reason = f"reached max_iter={opts.max_iter}"
     since_best = 0
     nxt = NextPlant(PD=G.sys, orders=(), K_ref=None)  # the plant of the next K-step
@@ -610,8 +622,6 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
 
         improved = best is None or mu_peak < best[0] * (1 - opts.min_improvement)
         if (best is None or mu_peak < best[0]) and all(c.met for c in certs):
-            if best is None:  # where the D-scale search starts (see ``dscale_search``)
-                first_dstep = (here.d_blocks, here.upper)
             best = (mu_peak, K, it)
         elif best is None:
             raise InfeasibleError("the first K-step's controller violates " + "; ".join(
@@ -624,6 +634,20 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         done = _done(setup, it, mu_peak, float(syn.gamma), gamma_prev, since_best,
                      excused=excused)
 
+        # the D-scale search starts from this D-step: tried first, it ends D-K where it
+        # beats the iterate (see ``dscale_search``)
+        found = None
+        if it == 1 and _search_applies(setup, best):
+            found = _search_stage(G, nmeas, ncon, setup.dk_struct, omega,
+                                  (here.d_blocks, here.upper), opts, rng, index=2,
+                                  hinfsyn=hinfsyn)
+            if found is not None and found.mu_peak < best[0]:
+                done = ("" if done is None else done + "; ") + (
+                    f"D-scale search from iteration 1 to µ {found.mu_peak:.4f} (it "
+                    "replaces the later D-K iterations)")
+            elif found is not None:
+                logger.info("musyn: the D-scale search (µ %.4f) did not beat iteration 1; "
+                            "D-K goes on", found.mu_peak)
         orders: tuple = ()
         t3 = time.perf_counter()
         if done is None:
@@ -651,26 +675,37 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
                     record.seconds_d, record.seconds_fit)
         if callback is not None:
             callback(record)
+        if found is not None and found.mu_peak < best[0]:
+            history.append(found)
+            if callback is not None:
+                callback(found)
+            best = (found.mu_peak, found.K, found.index)
+            found = None
+        elif found is not None:
+            searched = found  # kept, and recorded after the D-K iterations
         if done is not None:
             stop_reason = done
             break
 
-    if opts.dscale_search and best[0] >= opts.mu_target and constraints:
-        logger.info("musyn: no D-scale search with constraints (its K-step is Riccati's)")
-    elif opts.dscale_search and best[0] >= opts.mu_target and mixed:
-        logger.info("musyn: no D-scale search with real blocks (it searches D alone)")
-    elif opts.dscale_search and best[0] >= opts.mu_target:
-        found = _search_stage(G, nmeas, ncon, setup.dk_struct, omega, first_dstep, opts, rng,
-                              index=len(history) + 1, hinfsyn=hinfsyn)
-        if found is not None:
-            history.append(found)
-            if callback is not None:
-                callback(found)
-            if found.mu_peak < best[0]:
-                best = (found.mu_peak, found.K, found.index)
-                stop_reason += f"; D-scale search to µ {found.mu_peak:.4f}"
-
+    if searched is not None:
+        history.append(replace(searched, index=len(history) + 1))
+        if callback is not None:
+            callback(history[-1])
     return _certified(setup, best, history, stop_reason, t_start)
+
+
+def _search_applies(setup, best) -> bool:
+    """Whether the D-scale search runs after the first iterate (``dscale_search``)."""
+    opts = setup.options
+    if not opts.dscale_search or best[0] < opts.mu_target:
+        return False
+    if setup.constraints:
+        logger.info("musyn: no D-scale search with constraints (its K-step is Riccati's)")
+        return False
+    if setup.mixed:
+        logger.info("musyn: no D-scale search with real blocks (it searches D alone)")
+        return False
+    return True
 
 
 def _certified(setup, best, history, stop_reason: str, t_start: float) -> MusynResult:
@@ -855,7 +890,7 @@ def _with_uncertainty(P, blk, nmeas: int, ncon: int):
 
 
 def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hinfsyn):
-    """The direct D-scale search after the loop (:mod:`.dsearch`), as one more record;
+    """The direct D-scale search from a D-step (:mod:`.dsearch`), as one more record;
     None where it does not apply or finds no controller."""
     d_blocks, upper = dstep
     d_blocks = np.asarray(d_blocks)

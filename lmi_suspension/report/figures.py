@@ -432,6 +432,13 @@ def plot_occupant_tradeoff(points: Sequence, *, worst_goal: float = 1.5,
         The goals, as multiples of each seat's own limit.
     u_actuator, x1_bound : float
         The actuator's force limit (N) and the stroke's bound (m).
+    title : str
+        The figure's title.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Three panels, one point per design on each line.
 
     Examples
     --------

@@ -30,6 +30,7 @@ import math
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
+from types import MappingProxyType
 from typing import Callable, ClassVar, Mapping
 
 import control
@@ -354,6 +355,8 @@ class OccupantTradeoffPoint:
     rs_mu, rp_mu : float
         Mixed µ of robust stability and of robust performance over the set, bounded
         between the grid's points (:func:`~.occupants.occupant_mu`).
+    rs_lower, rp_lower : float
+        Their lower bounds on the frequency grid: µ is certainly at least these.
     """
 
     u_bound: float
@@ -368,6 +371,13 @@ class OccupantTradeoffPoint:
     searched_x1: Mapping
     rs_mu: float
     rp_mu: float
+    rs_lower: float
+    rp_lower: float
+
+    def __post_init__(self):
+        # read-only views, so that a frozen point cannot be changed through its mappings
+        object.__setattr__(self, "searched_u", MappingProxyType(dict(self.searched_u)))
+        object.__setattr__(self, "searched_x1", MappingProxyType(dict(self.searched_x1)))
 
     @property
     def u_searched(self) -> float:
@@ -380,13 +390,35 @@ class OccupantTradeoffPoint:
         return float(self.searched_x1["value"])
 
 
-def load_occupant_tradeoff(path=None) -> tuple[tuple[OccupantTradeoffPoint, ...], dict]:
-    """The force bound's trade-off of the occupant route over the set: ``(points, table)``,
-    the points by rising ``u_bound`` (the shipped measurement by default:
-    :data:`SHIPPED_OCCUPANT_TRADEOFF`).  ``table["command"]`` measured them and
-    ``table["made"]`` says how the designs were made; a point's design file is read by
-    :func:`~.routes.load_seat_design` (relative names beside the table).  Plot with
-    :func:`~lmi_suspension.report.figures.plot_occupant_tradeoff`.
+def load_occupant_tradeoff(path: str | Path | None = None,
+                           ) -> tuple[tuple[OccupantTradeoffPoint, ...], dict]:
+    """The force bound's trade-off of the occupant route over the set.
+
+    Parameters
+    ----------
+    path : str or Path, optional
+        A table written like :data:`SHIPPED_OCCUPANT_TRADEOFF` (the default, the shipped
+        measurement).
+
+    Returns
+    -------
+    points : tuple of OccupantTradeoffPoint
+        By rising ``u_bound``; each ``design`` is an absolute path (a relative name in the
+        table is beside the table).  Read a design with
+        ``load_seat_design(p.design, route="occupants")`` (:func:`~.routes.load_seat_design`)
+        or :func:`~.refine.load_refined`.
+    table : dict
+        The whole table: ``table["command"]`` measured the points, ``table["made"]``
+        says how the designs were made and ``table["seconds"]`` what the command took.
+
+    Raises
+    ------
+    ParameterError
+        A point lacks a field of :class:`OccupantTradeoffPoint`.
+
+    See Also
+    --------
+    lmi_suspension.report.figures.plot_occupant_tradeoff : draws the points.
 
     Examples
     --------
@@ -398,13 +430,16 @@ def load_occupant_tradeoff(path=None) -> tuple[tuple[OccupantTradeoffPoint, ...]
     """
     import json
 
-    path = Path(SHIPPED_OCCUPANT_TRADEOFF if path is None else path)
+    path = Path(SHIPPED_OCCUPANT_TRADEOFF if path is None else path).resolve()
     table = json.loads(path.read_text())
-    fields = set(OccupantTradeoffPoint.__dataclass_fields__)
+    fields = OccupantTradeoffPoint.__dataclass_fields__
     points = []
-    for p in table["points"]:
+    for i, p in enumerate(table["points"]):
+        missing = [k for k in fields if k not in p]
+        if missing:
+            raise ParameterError(f"{path}: point {i} lacks {', '.join(missing)}")
         design = Path(p["design"])
-        point = OccupantTradeoffPoint(**{k: v for k, v in p.items() if k in fields})
-        points.append(replace(point, design=str(design if design.is_absolute()
-                                                 else path.parent / design)))
+        values = {k: v for k, v in p.items() if k in fields}
+        values["design"] = str(design if design.is_absolute() else path.parent / design)
+        points.append(OccupantTradeoffPoint(**values))
     return tuple(sorted(points, key=lambda q: q.u_bound)), table
