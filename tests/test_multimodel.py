@@ -201,19 +201,30 @@ def test_the_trade_off_table_is_read_wherever_it_lies(tmp_path, monkeypatch):
     from lmi_suspension.seat.multimodel import (SHIPPED_OCCUPANT_TRADEOFF, SHIPPED_OCCUPANTS,
                                                 load_occupant_tradeoff)
 
+    import pickle
+
     table = json.loads(SHIPPED_OCCUPANT_TRADEOFF.read_text())
-    table["points"] = table["points"][:2]
-    table["points"][0]["design"] = str(SHIPPED_OCCUPANTS)          # absolute
-    table["points"][1]["design"] = "u1750.json"                    # beside the table
+    table["points"] = table["points"][1::-1]                       # 1750 N, then 1500 N
+    table["points"][1]["design"] = str(SHIPPED_OCCUPANTS)          # absolute
+    table["points"][0]["design"] = "u1750.json"                    # beside the table
     (tmp_path / "t.json").write_text(json.dumps(table))
     monkeypatch.chdir(tmp_path.parent)
     points, _ = load_occupant_tradeoff(Path(tmp_path.name) / "t.json")
     monkeypatch.chdir(SHIPPED_OCCUPANTS.parent.parent)
+    assert [p.u_bound for p in points] == [1500.0, 1750.0]          # sorted by bound
     assert points[0].design == str(SHIPPED_OCCUPANTS)
     assert points[1].design == str(tmp_path.resolve() / "u1750.json")
     with pytest.raises(TypeError):
-        points[0].searched_u["value"] = 0.0                           # read-only
-    del table["points"][1]["rs_lower"]
+        points[0].searched_u["value"] = 0.0                           # read-only,
+    with pytest.raises(TypeError):
+        points[0].searched_u["seat"]["m3"] = 50.0                     # nested too
+    again = pickle.loads(pickle.dumps(points[0]))                     # for Dask
+    assert again == points[0] and again.searched_u["seat"]["m3"] == 30.0
+    del table["points"][0]["rs_lower"]
     (tmp_path / "t.json").write_text(json.dumps(table))
-    with pytest.raises(ParameterError, match="point 1 lacks rs_lower"):
+    with pytest.raises(ParameterError, match="point 0 lacks rs_lower"):
         load_occupant_tradeoff(tmp_path / "t.json")
+    for bad in ("{", json.dumps({"rows": []})):
+        (tmp_path / "t.json").write_text(bad)
+        with pytest.raises(ParameterError, match="not a trade-off table"):
+            load_occupant_tradeoff(tmp_path / "t.json")

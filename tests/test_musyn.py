@@ -18,8 +18,7 @@ from lmi_suspension.synthesis.hinfsyn import _hinfsyn
 
 @pytest.fixture(scope="module")
 def distillation_design():
-    """Iteration 1 and the D-scale search from its D-step (which replaces the later
-    D-K iterations where it beats the first)."""
+    """D-K with the D-scale search from iteration 1's D-step (the default)."""
     ex = skogestad_distillation()
     records = []
     omega = np.logspace(-3, 3, 61)  # the book's grid (and dkpy's example of the problem)
@@ -72,14 +71,18 @@ def test_distillation_reaches_below_one(distillation_design, distillation_dk):
     # the exact series connections (minreal's realization had let K-steps certify below
     # the µ of their own loop)
     assert min(h.mu_peak for h in dk.history) < 1.02
-    # the search starts from iteration 1's D-step, the same in both runs, and ends below
-    # every D-K iterate, so it replaces the iterations after the first
-    assert res.history[0].mu_peak == dk.history[0].mu_peak
-    search = res.history[-1]
-    assert [h.stage for h in res.history] == ["dk", "dscale_search"]
-    assert res.best_iteration == search.index == 2
+    # the search runs after iteration 1; the D-K iterations after it are those of the
+    # run without it (its own generator), and stop once ``patience`` of them in a row
+    # have not beaten it, which no D-K iterate does here
+    *loop, search = res.history
+    assert [h.stage for h in loop] == ["dk"] * len(loop)
+    assert [(h.mu_peak, h.mu_lower_peak, h.gamma) for h in loop] == [
+        (h.mu_peak, h.mu_lower_peak, h.gamma) for h in dk.history[:len(loop)]]
+    assert search.stage == "dscale_search"
+    assert res.best_iteration == search.index == len(loop) + 1
     assert search.mu_peak < min(h.mu_peak for h in dk.history)
-    assert "D-scale search from iteration 1" in res.stop_reason
+    assert len(loop) == 1 + 3 and "no improvement" in res.stop_reason  # patience=3
+    assert "D-scale search to µ" in res.stop_reason
     assert search.gamma < search.gamma_prev  # below the γ of its starting scalings
     assert res.mu_peak < 1.0  # 0.97-0.98 measured
     # (the dense grid reaches 1e-9 rad/s, where the loop's double-precision response is
@@ -173,7 +176,10 @@ def test_history_and_best_iterate(run, request):
     peaks = [h.mu_peak for h in res.history]
     assert res.best_iteration == int(np.argmin(peaks)) + 1
     assert all(h.seconds_k > 0 and h.seconds_d > 0 for h in res.history)
-    assert all(h.stage == "dk" for h in res.history[:-1])
+    stages = ["dk"] * len(res.history)
+    if run == "distillation_design":
+        stages[-1] = "dscale_search"
+    assert [h.stage for h in res.history] == stages
     # For a stable, minimum-phase D fit the certified γ of the scaled loop bounds µ at
     # every frequency, so it is never below the grid peak of the next D-step.
     for h in res.history:
@@ -881,36 +887,69 @@ def test_a_plain_rebuild_is_not_repeated_by_a_restart():
     assert source is best
 
 
-def test_a_search_that_does_not_beat_the_first_iterate_leaves_dk_to_go_on(monkeypatch):
-    """The D-scale search runs once, from iteration 1's D-step.  Injected: its record
-    reads µ 10 times its own, above iteration 1's.  D-K then runs its iterations as
-    without the search, the search's record follows them (indices still the history's
-    positions), and the returned controller is the best D-K iterate's; with the search
-    left as it is, it replaces iterations 2 and 3."""
+def test_dk_after_the_search_is_dk_without_it_until_it_stops(monkeypatch):
+    """The D-scale search runs once, from iteration 1's D-step, with its own copy of the
+    generator: the D-K iterations after it are those of the run without it, to the
+    last digit, and only their stopping rule sees it.  Injected: a search whose record
+    reads µ 10 times its own, which no iterate fails to beat: D-K then runs exactly as
+    without it (same iterations, same stop), the search's record last and not
+    returned.  As it is, the search ends D-K after ``patience`` iterates that do not
+    beat it, and is returned."""
     from lmi_suspension.mu import dk
 
     real, calls = dk._search_stage, []
 
     def worse(*args, **kwargs):
-        calls.append(kwargs["index"])
+        calls.append(1)
         found = real(*args, **kwargs)
         return dataclasses.replace(found, mu_peak=10.0 * found.mu_peak)
 
     ex = skogestad_distillation()
-    opts = MusynOptions(method="riccati", max_iter=3, patience=3, dscale_search=3)
+    opts = MusynOptions(method="riccati", max_iter=4, patience=1, dscale_search=30)
     omega = np.logspace(-3, 3, 31)
-    as_is = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=omega, options=opts)
+
+    def run(o):
+        return musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=omega, options=o,
+                     rng=np.random.default_rng(5))
+
+    def figures(h):
+        return (h.mu_peak, h.mu_lower_peak, h.gamma)
+
+    alone = run(dataclasses.replace(opts, dscale_search=0))
+    as_is = run(opts)
     monkeypatch.setattr(dk, "_search_stage", worse)
-    res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=omega, options=opts)
-    assert calls == [2]  # once, after iteration 1
-    assert [h.stage for h in res.history] == ["dk"] * 3 + ["dscale_search"]
-    assert [h.index for h in res.history] == [1, 2, 3, 4]
-    assert res.best_iteration == 1 + int(np.argmin([h.mu_peak for h in res.history[:3]]))
-    assert res.stop_reason == "reached max_iter=3"
-    assert [h.stage for h in as_is.history] == ["dk", "dscale_search"]
-    assert as_is.best_iteration == 2 and as_is.history[1].mu_peak < as_is.history[0].mu_peak
-    assert as_is.history[0].mu_peak == res.history[0].mu_peak
-    assert res.history[3].mu_peak == pytest.approx(10.0 * as_is.history[1].mu_peak, rel=1e-9)
+    beside = run(opts)
+    assert calls == [1]  # once, after iteration 1
+    assert [figures(h) for h in beside.history[:-1]] == [figures(h) for h in alone.history]
+    assert beside.history[-1].stage == "dscale_search"
+    assert [h.index for h in beside.history] == list(range(1, len(alone.history) + 2))
+    assert beside.stop_reason == alone.stop_reason
+    assert beside.best_iteration == alone.best_iteration
+    # as it is: beaten by no iterate, it stops D-K after one (patience=1) and is returned
+    *loop, search = as_is.history
+    assert [figures(h) for h in loop] == [figures(h) for h in alone.history[:2]]
+    assert search.stage == "dscale_search" and as_is.best_iteration == 3
+    assert search.mu_peak < min(h.mu_peak for h in loop)
+
+
+def test_where_the_search_runs():
+    """Not with constraints (its K-step is Riccati's), not with real blocks kept real
+    (it searches D alone), not once ``mu_target`` is met, and not when turned off."""
+    from types import SimpleNamespace
+
+    from lmi_suspension.mu.dk import _search_applies
+
+    def setup(constraints=(), mixed=False, **kw):
+        return SimpleNamespace(options=MusynOptions(**kw), constraints=constraints,
+                               mixed=mixed)
+
+    best = (1.2, None, 1)
+    assert _search_applies(setup(), best)
+    assert _search_applies(setup(mu_target=1.1), best)
+    assert not _search_applies(setup(mu_target=1.3), best)
+    assert not _search_applies(setup(dscale_search=0), best)
+    assert not _search_applies(setup(constraints=(object(),)), best)
+    assert not _search_applies(setup(mixed=True), best)
 
 
 def test_an_iterate_whose_mu_lower_bound_beats_its_gamma_is_flagged(monkeypatch):
@@ -1003,25 +1042,26 @@ def test_central_start_falls_back_to_the_lmi_controller():
 
 @pytest.mark.slow
 def test_default_lmi_dk_on_distillation_goes_below_one():
-    """Default ``musyn`` (the central first iterate, then the D-scale search from its
-    D-step, which replaces the later LMI K-steps where it beats the first iterate) on
-    the S&P (2005) Table 8.1 problem, the book's 61-point grid.  Issue 15's target is
-    µ <= 0.98; measured 2026-11-29 under OpenBLAS Nehalem, Sandybridge, Haswell and
-    SkylakeX on 1 and 2 threads: 0.959417-0.959536 (upper = lower bound), as with eight
-    D-K iterations before the search (2026-11-28), where the LMI's own first controller
-    once led to 1.02-1.04.  References: the book's manual D-K reaches 0.9998 at
-    iteration 7 and its µ-optimal third-order scalings 0.9740 (Sec. 8.12.4); dkpy's D-K
-    stalls near 1.04.  Certificates as in the Riccati-led test above: the returned µ
-    does not exceed the γ certified for its controller on its scaled plant, and the
-    dense-grid lower bound meets the upper one.  (The LMI K-step at a fixed level, which
-    D-K runs after the first iterate with ``dscale_search=0``, is
-    ``test_lmi_k_step_at_the_level_of_a_certified_controller``.)"""
+    """Default ``musyn`` (the central first iterate, the D-scale search from its
+    D-step, then LMI K-steps at a fixed level until ``patience`` iterates in a row have
+    not beaten the search) on the S&P (2005) Table 8.1 problem, the book's 61-point
+    grid.  Issue 15's target is µ <= 0.98; measured 2026-11-29 under OpenBLAS Nehalem,
+    Sandybridge, Haswell and SkylakeX on 1 and 2 threads: 0.959417-0.959536 (upper =
+    lower bound), the same as with the search after eight D-K iterations (2026-11-28),
+    where the LMI's own first controller once led to 1.02-1.04.  References: the book's
+    manual D-K reaches 0.9998 at iteration 7 and its µ-optimal third-order scalings
+    0.9740 (Sec. 8.12.4); dkpy's D-K stalls near 1.04.  Certificates as in the
+    Riccati-led test above: the returned µ does not exceed the γ certified for its
+    controller on its scaled plant, and the dense-grid lower bound meets the upper one."""
     ex = skogestad_distillation()
     res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-3, 3, 61))
     assert any(w.startswith("first iterate: the central controller")
                for w in res.history[0].warnings)
-    assert [h.stage for h in res.history] == ["dk", "dscale_search"]
-    assert res.best_iteration == 2
+    assert any(w.startswith("LMI K-step at") for h in res.history[1:-1] for w in h.warnings)
+    # no D-K iterate beats the search (1.04 and 1.00 against 0.96): D-K stops after
+    # patience = 2 of them
+    assert [h.stage for h in res.history] == ["dk"] * 3 + ["dscale_search"]
+    assert res.best_iteration == 4
     assert res.mu_peak < 0.99
     best = res.history[res.best_iteration - 1]
     assert res.mu_peak <= best.gamma * (1 + 1e-3)

@@ -16,7 +16,8 @@ constraint), patience, the stopping rules, and the certificates of each iterate 
 closed-loop poles, µ lower bound against its γ, constraints recomputed).  After the
 first iterate, a direct search on the D-scale fit parameters with the K-step inside
 (:mod:`.dsearch`), started from that iterate's D-step, goes on to a local minimum of the
-bound where D-K stalls; where it beats the iterate it replaces the later D-K iterations
+bound where D-K stalls; the D-K iterations after it go on as without it, and stop once
+``patience`` of them have not beaten the best so far, the search's included
 (``dscale_search``).  The best iterate is returned, never a worse last one; its µ is certified on
 a dense grid with the true structure (real blocks real), the grid peak refined with the
 LMI bound (:func:`_final_bounds`) and bounded between grid points (``mu_bound``).
@@ -25,6 +26,7 @@ LMI bound (:func:`_final_bounds`) and bounded between grid points (``mu_bound``)
 
 from __future__ import annotations
 
+import copy
 import logging
 import time
 from dataclasses import dataclass, field, replace
@@ -92,13 +94,14 @@ class MusynOptions:
     ----------
     max_iter : int
         Largest number of D-K iterations (each = one K-step, one D-step, one D-fit).
-        Where the D-scale search runs and beats the first iterate, there is one
-        (``dscale_search``).
+        The D-scale search (``dscale_search``) is not counted.
     mu_target : float
         Stop as soon as the µ peak falls below this value (``0`` never stops early).
     patience : int
         Stop after this many iterations without a relative improvement of at least
-        ``min_improvement`` over the best peak so far.
+        ``min_improvement`` over the best peak so far, the D-scale search's included:
+        by default D-K stops once ``patience`` iterates in a row stay above the search
+        (``dscale_search=0`` runs D-K alone, as MATLAB's ``musyn`` does).
     min_improvement : float
         Relative improvement that counts as progress.
     method : {"lmi", "riccati", "best"}
@@ -173,8 +176,8 @@ class MusynOptions:
         ``musyn`` in 15-26 s with the halving, 18-32 s without, over 4 OpenBLAS kernels
         and 1 and 2 threads; measured 2026-11-26).
     dscale_search : int
-        After the first D-K iterate, at most this many points (a K-step's level each) of
-        a direct search on the parameters of the D-scale fits (order
+        Right after the first D-K iterate, at most this many points (a K-step's level
+        each) of a direct search on the parameters of the D-scale fits (order
         ``max_dfit_order``), started from the D-step of that iterate: a
         descent method for the piecewise-smooth level
         SLICOT's Riccati synthesis achieves on each scaled plant (BFGS on difference
@@ -187,21 +190,24 @@ class MusynOptions:
         controllers are not unique), and the search ends near a local minimum, which
         small differences of its path mostly lead back to: default ``musyn`` on
         distillation gave µ 0.959417-0.959536 under four OpenBLAS kernels and 1 and 2
-        threads, in 18-29 s (the previous Nelder-Mead search from the best iterate:
+        threads (the previous Nelder-Mead search from the best iterate:
         0.9636-0.9716).  Mostly, not always: on 51- and 71-point grids the Haswell and
         Sandybridge kernels ended in different local minima, 0.2 % and 0.5 % apart
         (measured 2026-11-26).  Blocks whose optimal scalings coincide share one fit.
-        Where its µ peak beats the first iterate's, its controller is kept and the D-K
-        iterations after the first are not run: the search starts from the first
-        iterate's D-step whatever they do, and on distillation they never ended below
-        it (best D-K iterate 0.978-0.983 against 0.9594-0.9595 on 8 kernel rows) while
-        costing 1-15 s of LMI K-steps; D-K continued from the search's controller
-        failed at its first K-step, the LMI finding no controller 0.3 % above SLICOT's
-        level (measured 2026-11-29).  Where the search finds nothing or does not beat
-        the first iterate, D-K goes on as without it, and the search's record follows
-        the loop's.  ``0`` turns the search off, and D-K runs its ``max_iter``
-        iterations.  Skipped for constant scalings (``max_dfit_order = 0``),
-        with constraints, and once ``mu_target`` is met; it stops as soon as an
+        The search starts from the first iterate's D-step whatever D-K does after it,
+        so it runs right then, and the D-K iterations after it go on as without it (it
+        draws from its own copy of ``rng``) but measure their progress against it: D-K
+        stops once ``patience`` iterates in a row have not beaten the best so far, the
+        search's included.  So D-K goes on where it can still beat the search, and
+        stops early where it cannot: on distillation the D-K iterates after the first
+        never ended below the search (best recorded 0.9784 and 0.9806 against
+        0.9594-0.9595) while their LMI K-steps cost 1.1-14.8 s per run; on the seat's
+        µ problem with fourth-order fits D-K's third iterate (0.6998) beat the search
+        (0.7024) and is returned (measured 2026-11-28 and 29, benchmarks/HISTORY.md).
+        The search's record follows the D-K iterations, and the lower of all is
+        returned.  ``0`` turns the search off.  Skipped
+        for constant scalings (``max_dfit_order = 0``), with constraints, with real
+        blocks kept real (D-G-K), and once ``mu_target`` is met; it stops as soon as an
         accepted level is below ``mu_target``.  A level costs 15 (difference
         quotient) to 20 (trial step) syntheses of 3-4 ms on distillation's 22-state
         scaled plants, a trial point found above the current level one (measured
@@ -514,7 +520,10 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
     options : MusynOptions, optional
         Iteration bounds, stopping rules, K-step method, D-fit and reduction settings.
     callback : callable, optional
-        Called with each :class:`MusynIteration` as soon as it is complete (progress).
+        Called with each :class:`MusynIteration` as soon as it is complete (progress);
+        the first iterate's record comes once the D-scale search that starts from it
+        has ended (about 10 s on distillation), the search's after the last D-K
+        iteration.
     rng : numpy.random.Generator, optional
         Seeds the µ lower-bound restarts (default ``np.random.default_rng(0)``).
     constraints : sequence of Specification, optional
@@ -594,7 +603,7 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
 
     history: list[MusynIteration] = []
     best = None  # (mu_peak, K, index)
-    searched = None  # a D-scale search that did not beat iteration 1
+    searched = None  # the D-scale search's record, from iteration 1's D-step
     stop_reason = f"reached max_iter={opts.max_iter}"
     since_best = 0
     nxt = NextPlant(PD=G.sys, orders=(), K_ref=None)  # the plant of the next K-step
@@ -620,7 +629,12 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         t2 = time.perf_counter()
         mu_peak = here.mu_peak
 
-        improved = best is None or mu_peak < best[0] * (1 - opts.min_improvement)
+        # progress is judged against the best so far, the D-scale search's included: D-K
+        # goes on while it may still beat the search (see ``dscale_search``)
+        bar = np.inf if best is None else best[0]
+        if searched is not None:
+            bar = min(bar, searched.mu_peak)
+        improved = mu_peak < bar * (1 - opts.min_improvement)
         if (best is None or mu_peak < best[0]) and all(c.met for c in certs):
             best = (mu_peak, K, it)
         elif best is None:
@@ -634,20 +648,15 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         done = _done(setup, it, mu_peak, float(syn.gamma), gamma_prev, since_best,
                      excused=excused)
 
-        # the D-scale search starts from this D-step: tried first, it ends D-K where it
-        # beats the iterate (see ``dscale_search``)
-        found = None
+        # the D-scale search starts from this D-step, so it runs now, and the D-K
+        # iterations after it measure their progress against it; its own copy of the
+        # generator leaves them as they are without it
         if it == 1 and _search_applies(setup, best):
-            found = _search_stage(G, nmeas, ncon, setup.dk_struct, omega,
-                                  (here.d_blocks, here.upper), opts, rng, index=2,
-                                  hinfsyn=hinfsyn)
-            if found is not None and found.mu_peak < best[0]:
-                done = ("" if done is None else done + "; ") + (
-                    f"D-scale search from iteration 1 to µ {found.mu_peak:.4f} (it "
-                    "replaces the later D-K iterations)")
-            elif found is not None:
-                logger.info("musyn: the D-scale search (µ %.4f) did not beat iteration 1; "
-                            "D-K goes on", found.mu_peak)
+            searched = _search_stage(G, nmeas, ncon, setup.dk_struct, omega,
+                                     (here.d_blocks, here.upper), opts, copy.deepcopy(rng),
+                                     index=0, hinfsyn=hinfsyn)
+            if searched is not None and searched.mu_peak < opts.mu_target and done is None:
+                done = f"the D-scale search reached mu_target={opts.mu_target:g}"
         orders: tuple = ()
         t3 = time.perf_counter()
         if done is None:
@@ -675,23 +684,33 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
                     record.seconds_d, record.seconds_fit)
         if callback is not None:
             callback(record)
-        if found is not None and found.mu_peak < best[0]:
-            history.append(found)
-            if callback is not None:
-                callback(found)
-            best = (found.mu_peak, found.K, found.index)
-            found = None
-        elif found is not None:
-            searched = found  # kept, and recorded after the D-K iterations
         if done is not None:
             stop_reason = done
             break
 
-    if searched is not None:
+    if searched is not None:  # recorded after the D-K iterations it ran beside
         history.append(replace(searched, index=len(history) + 1))
         if callback is not None:
             callback(history[-1])
+        if _search_wins(searched, history[best[2] - 1], setup):
+            best = (searched.mu_peak, searched.K, len(history))
+            stop_reason += f"; D-scale search to µ {searched.mu_peak:.4f}"
     return _certified(setup, best, history, stop_reason, t_start)
+
+
+def _search_wins(searched: MusynIteration, dk_best: MusynIteration, setup) -> bool:
+    """Whether the D-scale search's peak is below the best D-K iterate's, like with like:
+    the search's is the LMI-refined bound (:func:`_final_bounds`), an iterate's the fast
+    one, which can stall above it (up to 0.06 % on distillation's flat loops).  The
+    iterate's bound is refined only where its lower bound leaves the question open (µ
+    lies between the two)."""
+    if searched.mu_peak >= dk_best.mu_peak:
+        return False
+    if searched.mu_peak <= dk_best.mu_lower_peak:
+        return True
+    refined = _final_bounds(lft(setup.G, dk_best.K), setup.dk_struct, setup.omega,
+                            copy.deepcopy(setup.rng))
+    return searched.mu_peak < float(np.max(refined.upper))
 
 
 def _search_applies(setup, best) -> bool:

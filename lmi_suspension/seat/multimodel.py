@@ -30,7 +30,6 @@ import math
 import time
 from dataclasses import dataclass, replace
 from pathlib import Path
-from types import MappingProxyType
 from typing import Callable, ClassVar, Mapping
 
 import control
@@ -331,6 +330,30 @@ class OccupantRoute:
                                 figures={**_figures(d.design), "rounds": len(d.rounds)})
 
 
+class _ReadOnly(Mapping):
+    """A read-only copy of a mapping, nested mappings included; pickles as a dict."""
+
+    def __init__(self, items: Mapping):
+        self._items = {k: _ReadOnly(v) if isinstance(v, Mapping) else v
+                       for k, v in items.items()}
+
+    def __getitem__(self, key):
+        return self._items[key]
+
+    def __iter__(self):
+        return iter(self._items)
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def __repr__(self) -> str:
+        return repr(self._items)
+
+    def __reduce__(self):
+        return _ReadOnly, ({k: dict(v) if isinstance(v, _ReadOnly) else v
+                            for k, v in self._items.items()},)
+
+
 @dataclass(frozen=True)
 class OccupantTradeoffPoint:
     """One design of the force bound's trade-off over the set, as ``lmi-suspension
@@ -375,9 +398,10 @@ class OccupantTradeoffPoint:
     rp_lower: float
 
     def __post_init__(self):
-        # read-only views, so that a frozen point cannot be changed through its mappings
-        object.__setattr__(self, "searched_u", MappingProxyType(dict(self.searched_u)))
-        object.__setattr__(self, "searched_x1", MappingProxyType(dict(self.searched_x1)))
+        # read-only, nested included, so that a frozen point cannot be changed through
+        # its mappings (and still pickles, for Dask)
+        object.__setattr__(self, "searched_u", _ReadOnly(self.searched_u))
+        object.__setattr__(self, "searched_x1", _ReadOnly(self.searched_x1))
 
     @property
     def u_searched(self) -> float:
@@ -414,7 +438,8 @@ def load_occupant_tradeoff(path: str | Path | None = None,
     Raises
     ------
     ParameterError
-        A point lacks a field of :class:`OccupantTradeoffPoint`.
+        The file is not JSON, has no ``points``, or a point lacks a field of
+        :class:`OccupantTradeoffPoint`.
 
     See Also
     --------
@@ -431,10 +456,14 @@ def load_occupant_tradeoff(path: str | Path | None = None,
     import json
 
     path = Path(SHIPPED_OCCUPANT_TRADEOFF if path is None else path).resolve()
-    table = json.loads(path.read_text())
+    try:
+        table = json.loads(path.read_text())
+        rows = table["points"]
+    except (json.JSONDecodeError, KeyError, TypeError) as exc:
+        raise ParameterError(f"{path}: not a trade-off table ({exc!r})") from exc
     fields = OccupantTradeoffPoint.__dataclass_fields__
     points = []
-    for i, p in enumerate(table["points"]):
+    for i, p in enumerate(rows):
         missing = [k for k in fields if k not in p]
         if missing:
             raise ParameterError(f"{path}: point {i} lacks {', '.join(missing)}")
