@@ -156,8 +156,8 @@ plt.show()
 # 200 K-step levels): a descent method on the level a Riccati K-step achieves on each
 # scaled plant; the best point's controller is certified. The D-K iterations after it
 # stop once `patience` of them have not beaten it. First, D-K alone (`dscale_search=0`,
-# six iterations), to compare with the book; then the defaults (`method="best"`), whose
-# result is the search's row, last.
+# six iterations), to compare with the book; then the default iteration options with
+# `method="best"`, whose result is the search's row, last.
 
 # %%
 opts = MusynOptions(max_iter=6, patience=6, min_improvement=0.0, method="best", n_dense=200)

@@ -100,8 +100,10 @@ class MusynOptions:
     patience : int
         Stop after this many iterations without a relative improvement of at least
         ``min_improvement`` over the best peak so far, the D-scale search's included:
-        by default D-K stops once ``patience`` iterates in a row stay above the search
-        (``dscale_search=0`` runs D-K alone, as MATLAB's ``musyn`` does).
+        by default D-K stops once ``patience`` iterates in a row have not beaten the
+        search by ``min_improvement`` (an iterate's fast bound against the search's
+        LMI-refined one, which can sit up to 0.06 % lower; ``dscale_search=0`` runs D-K
+        alone, as MATLAB's ``musyn`` does).
     min_improvement : float
         Relative improvement that counts as progress.
     method : {"lmi", "riccati", "best"}
@@ -198,14 +200,18 @@ class MusynOptions:
         so it runs right then, and the D-K iterations after it go on as without it (it
         draws from its own copy of ``rng``) but measure their progress against it: D-K
         stops once ``patience`` iterates in a row have not beaten the best so far, the
-        search's included.  So D-K goes on where it can still beat the search, and
-        stops early where it cannot: on distillation the D-K iterates after the first
-        never ended below the search (best recorded 0.9784 and 0.9806 against
-        0.9594-0.9595) while their LMI K-steps cost 1.1-14.8 s per run; on the seat's
-        µ problem with fourth-order fits D-K's third iterate (0.6998) beat the search
-        (0.7024) and is returned (measured 2026-11-28 and 29, benchmarks/HISTORY.md).
-        The search's record follows the D-K iterations, and the lower of all is
-        returned.  ``0`` turns the search off.  Skipped
+        search's included, by ``min_improvement``.  So D-K goes on where it can still
+        beat the search, and stops early where it cannot: on distillation the D-K
+        iterates after the first never ended below the search (best recorded 0.9784
+        and 0.9806 against 0.9594-0.9595, 2026-11-28) while their LMI K-steps cost
+        1.1-14.8 s per run; on the seat's µ problem with fourth-order fits D-K's third
+        iterate beat the search (design grid 0.6998 against 0.7024; dense grid 0.69996
+        against 0.70450) and is returned (2026-11-29; benchmarks/HISTORY.md and
+        ``benchmarks/musyn_problems.py``).  The search's record follows the D-K
+        iterations, and the lowest µ of the loop is returned.  With ``complexify=True``
+        that is complex µ, what the loop iterates on; the µ reported is mixed µ, which
+        can order the candidates otherwise (complexified oscillator: the search's
+        controller 1.1309, D-K alone's 1.1120).  ``0`` turns the search off.  Skipped
         for constant scalings (``max_dfit_order = 0``), with constraints, with real
         blocks kept real (D-G-K), and once ``mu_target`` is met; it stops as soon as an
         accepted level is below ``mu_target``.  A level costs 15 (difference
@@ -613,7 +619,7 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
                                                    first=best is None)
         if failure is not None:
             stop_reason = f"K-step failed at iteration {it}: {failure}"
-            logger.warning("musyn: %s; keeping iteration %d", stop_reason, best[2])
+            logger.warning("musyn: %s; keeping the best so far", stop_reason)
             break
         K = syn.K
         t1 = time.perf_counter()

@@ -331,7 +331,8 @@ class OccupantRoute:
 
 
 class _ReadOnly(Mapping):
-    """A read-only copy of a mapping, nested mappings included; pickles as a dict."""
+    """A read-only copy of a mapping, nested mappings included (other values as they
+    are); it pickles, and compares equal to a dict of the same items."""
 
     def __init__(self, items: Mapping):
         self._items = {k: _ReadOnly(v) if isinstance(v, Mapping) else v
@@ -350,8 +351,7 @@ class _ReadOnly(Mapping):
         return repr(self._items)
 
     def __reduce__(self):
-        return _ReadOnly, ({k: dict(v) if isinstance(v, _ReadOnly) else v
-                            for k, v in self._items.items()},)
+        return _ReadOnly, (self._items,)
 
 
 @dataclass(frozen=True)
@@ -464,6 +464,8 @@ def load_occupant_tradeoff(path: str | Path | None = None,
     fields = OccupantTradeoffPoint.__dataclass_fields__
     points = []
     for i, p in enumerate(rows):
+        if not isinstance(p, Mapping):
+            raise ParameterError(f"{path}: point {i} is not a mapping")
         missing = [k for k in fields if k not in p]
         if missing:
             raise ParameterError(f"{path}: point {i} lacks {', '.join(missing)}")
