@@ -197,11 +197,10 @@ def test_the_trade_off_table_is_read_wherever_it_lies(tmp_path, monkeypatch):
     """A table elsewhere names its designs beside itself or by absolute path, whatever the
     working directory; a point that lacks a field is a typed error, not a TypeError."""
     import json
+    import pickle
 
     from lmi_suspension.seat.multimodel import (SHIPPED_OCCUPANT_TRADEOFF, SHIPPED_OCCUPANTS,
                                                 load_occupant_tradeoff)
-
-    import pickle
 
     table = json.loads(SHIPPED_OCCUPANT_TRADEOFF.read_text())
     table["points"] = table["points"][1::-1]                       # 1750 N, then 1500 N

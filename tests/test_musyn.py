@@ -947,6 +947,31 @@ def test_a_search_that_reaches_mu_target_ends_dk():
     assert res.stop_reason.startswith("the D-scale search reached mu_target=1")
 
 
+def test_the_search_is_compared_like_with_like(monkeypatch):
+    """The search's peak is LMI-refined, an iterate's the fast bound (no smaller): the
+    iterate's is refined (``_final_bounds``, stubbed here) only where the search lies
+    between its lower and fast upper peaks, and the refined value decides."""
+    from types import SimpleNamespace
+
+    from lmi_suspension.mu import dk
+
+    refined, calls = [], []
+    monkeypatch.setattr(dk, "lft", lambda G, K: None)
+    monkeypatch.setattr(dk, "_final_bounds", lambda CL, blk, w, rng: (
+        calls.append(1), SimpleNamespace(upper=np.array([0.5, refined[-1]])))[1])
+    setup = SimpleNamespace(G=None, dk_struct=None, omega=None,
+                            rng=np.random.default_rng(0))
+    iterate = SimpleNamespace(mu_peak=1.02, mu_lower_peak=0.98, K=None)
+
+    def wins(search_mu, refined_mu=np.nan):
+        refined.append(refined_mu)
+        return dk._search_wins(SimpleNamespace(mu_peak=search_mu), iterate, setup)
+
+    assert not wins(1.03) and wins(0.97) and not calls  # decided without refining
+    assert not wins(1.0, refined_mu=0.99) and wins(1.0, refined_mu=1.01)
+    assert len(calls) == 2
+
+
 def test_where_the_search_runs():
     """Not with constraints (its K-step is Riccati's), not with real blocks kept real
     (it searches D alone), not once ``mu_target`` is met, and not when turned off."""
