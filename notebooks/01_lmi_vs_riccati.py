@@ -25,7 +25,8 @@
 #   equations. It needs $D_{12}$ of full column rank, $D_{21}$ of full row rank and no
 #   invariant zeros of $(A, B_2, C_1, D_{12})$ or $(A, B_1, C_2, D_{21})$ on the imaginary axis.
 # * **LMI** (`hinfsyn(..., method="lmi")`): minimises γ over the projected (elimination) LMIs
-#   in $X, Y$ with Clarabel; it gives a *lower bound* `gamma_lower` valid for every controller,
+#   in $X, Y$ with Clarabel; it gives a *lower bound* `gamma_lower` valid for every controller
+#   up to the solver's accuracy (withheld where a certified Riccati controller beats it),
 #   then reconstructs a well-conditioned controller at a slightly relaxed γ. It needs none of
 #   the rank assumptions.
 #

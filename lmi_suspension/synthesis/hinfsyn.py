@@ -9,7 +9,8 @@ from dataclasses import replace
 import control
 import numpy as np
 
-from ..errors import (IllPosedLoopError, InfeasibleError, ParameterError, SolverError)
+from ..errors import (AssumptionError, IllPosedLoopError, InfeasibleError, ParameterError,
+                      SolverError)
 from ..lti.checks import as_statespace
 from ..lti.norms import hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
@@ -602,6 +603,41 @@ def _explicit(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling, sol,
     return None
 
 
+def _riccati_beats(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling,
+                   gamma_lower: float, opts: HinfsynOptions) -> tuple[float, float] | None:
+    """``(level, gamma)``: SLICOT's controller at ``level = gamma_lower / (1 +
+    gamma_relax)`` on ``G``, certified at ``gamma = hinfnorm(lft(G, K)) < gamma_lower``,
+    which proves that the γ minimisation's optimum ``gamma_lower`` (plant units) is no
+    lower bound; else None.
+
+    Clarabel can stop above the optimum with a status of "optimal" or "optimal
+    inaccurate" and a primal-dual gap that does not show it: on the plants of
+    ``bench_hinfsyn.py`` (n = 4 to 40) by 1.7e-5 to 1.8e-3, at 40 states 69.007 against
+    the 68.886 on which CVXOPT and a second solve in the frame of the first agree to
+    2.5e-5 (measured 2026-11-29, ``python benchmarks/gamma_alternatives.py 40
+    accuracy``).  The two Riccati solutions of ``Ps`` (the scaled plant) at ``level``
+    (:func:`~.lmi.riccati_frame`, 16 ms at 40 states; with SLICOT's controller and its
+    certificate 0.08 s) are only the cue: they are not checked to stabilise, nor
+    ``D11`` against ``level`` (a plant whose ``D11`` keeps every controller at 3 had
+    them at 2.9987), so the controller SLICOT forms at ``level`` is certified before
+    anything is said.  Plants that fail the Riccati
+    assumptions (singular ``D12`` or ``D21``) are not checked.  Only the reported
+    optimum is at stake: a second γ minimisation and controller LMI at 40 states cost
+    13-26 s for a controller certified 0.15 % lower, with poles 7-23 times faster
+    (measured the same day), so none is made.
+    """
+    level = gamma_lower / (1.0 + opts.gamma_relax)
+    if _lmi.riccati_frame(Ps, level * sc.gamma_factor) is None:
+        return None
+    try:
+        check_riccati_assumptions(G)
+        K, _ = _sb10ad(G, level)
+    except (AssumptionError, InfeasibleError, SolverError):
+        return None
+    gamma, _ = hinfnorm(lft(G, K))
+    return (level, float(gamma)) if gamma < gamma_lower else None
+
+
 def _unit_gamma(Ps: GeneralizedPlant, sc: PlantScaling, g: float, sols: list):
     """The errors scaled by ``1/f`` (``f``: ``g`` rounded to a power of two) so that the
     controller LMI sees γ near 1; in the bounded-real inequality this maps ``γ -> γ/f``,
@@ -788,6 +824,14 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float,
                         f"no controller reconstructed near it (certified {gamma:.6g}): it "
                         "is not a lower bound and is not reported")
         gamma_lower = None
+    elif gamma_lower is not None and gamma_lower > floor:
+        beaten = _riccati_beats(G, Ps, sc, gamma_lower, opts)
+        if beaten is not None:
+            warnings.append(f"SLICOT's Riccati controller at {beaten[0]:.6g} certifies "
+                            f"{beaten[1]:.6g}, below the γ minimisation's optimum "
+                            f"{gamma_lower:.6g}: it stopped high, is not a lower bound and "
+                            "is not reported")
+            gamma_lower = None
     t_rec = time.perf_counter() - t2 - t_cert - t_refine
     return HinfsynResult(
         K=K, CL=CL, gamma=gamma, gamma_solver=float(level), gamma_lower=gamma_lower,

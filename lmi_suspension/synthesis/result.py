@@ -27,7 +27,9 @@ class HinfsynOptions:
         the certified γ stays below ``(1 + gamma_relax) * gamma_lower`` up to solver
         accuracy.  Where that reconstruction fails, the level is relaxed fourfold per
         recovery (``4 gamma_relax``, ``16 gamma_relax``, ...).  The default keeps every
-        COMPleib problem of the tests within 0.04 % of the LMI optimum.
+        COMPleib problem of the tests within 0.04 % of the LMI optimum.  It is also the
+        margin by which a certified Riccati controller must be sought below
+        ``gamma_lower`` before ``gamma_lower`` is withheld (see ``HinfsynResult``).
     gamma_atol : float
         Absolute γ floor in scaled units (plant data normalised to about 1): when the LMI
         optimum is below it (an infimum of 0, e.g. COMPleib AC1) the reconstruction
@@ -162,9 +164,12 @@ class HinfsynResult:
         When the returned controller certifies below it, ``warnings`` says that the γ
         minimisation was inaccurate, and it is no lower bound (reported on COMPleib AC4 in
         issue 41; not reproduced on d4a1a73, tested by injection).  None at a
-        fixed ``gamma``, for the Riccati route, and where the certified γ is above even
+        fixed ``gamma``, for the Riccati route, where the certified γ is above even
         the most relaxed reconstruction level of it (``warnings`` then gives the value
-        the γ minimisation claimed).
+        the γ minimisation claimed), and, on a plant that meets the Riccati
+        assumptions, where SLICOT's controller at ``gamma_lower / (1 + gamma_relax)``
+        certifies below it (looked for where scipy's Riccati solutions exist at that
+        level; ``warnings`` gives the levels).
     poles : numpy.ndarray
         Closed-loop poles.
     status : str
