@@ -930,3 +930,26 @@ def test_riccati_solutions_alone_do_not_withhold_the_optimum():
     Ps, sc = scale_plant(GeneralizedPlant.from_statespace(P, 1, 1))
     cue = res.gamma_lower / (1 + HinfsynOptions().gamma_relax) * sc.gamma_factor
     assert riccati_frame(Ps, cue) is not None  # the cue that SLICOT's controller refutes
+
+
+@pytest.mark.parametrize("failure", [np.linalg.LinAlgError("injected"),
+                                     SolverError("injected"), ValueError("injected")])
+def test_a_failing_riccati_check_says_nothing(monkeypatch, failure):
+    """The check of the LMI optimum never fails the synthesis: with the Riccati cue made
+    to fire and SLICOT's controller made to fail (injected), the result is the one
+    without the check, ``gamma_lower`` included (8-state benchmark plant)."""
+    import importlib
+
+    mod = importlib.import_module("lmi_suspension.synthesis.hinfsyn")
+    P = _bench_plant(8)
+    ref = hinfsyn(P, 4, 4)
+    monkeypatch.setattr(mod._lmi, "riccati_frame", lambda Ps, gamma: object())
+
+    def failing(G, gamma):
+        raise failure
+
+    monkeypatch.setattr(mod, "_sb10ad", failing)
+    res = hinfsyn(P, 4, 4)
+    assert res.gamma_lower == ref.gamma_lower
+    assert res.gamma == ref.gamma
+    assert not any("SLICOT's Riccati controller" in w for w in res.warnings)

@@ -9,7 +9,7 @@ from dataclasses import replace
 import control
 import numpy as np
 
-from ..errors import (AssumptionError, IllPosedLoopError, InfeasibleError, ParameterError,
+from ..errors import (IllPosedLoopError, InfeasibleError, LmiSuspensionError, ParameterError,
                       SolverError)
 from ..lti.checks import as_statespace
 from ..lti.norms import hinfnorm
@@ -620,11 +620,12 @@ def _riccati_beats(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling,
     certificate 0.08 s) are only the cue: they are not checked to stabilise, nor
     ``D11`` against ``level`` (a plant whose ``D11`` keeps every controller at 3 had
     them at 2.9987), so the controller SLICOT forms at ``level`` is certified before
-    anything is said.  Plants that fail the Riccati
-    assumptions (singular ``D12`` or ``D21``) are not checked.  Only the reported
-    optimum is at stake: a second γ minimisation and controller LMI at 40 states cost
-    13-26 s for a controller certified 0.15 % lower, with poles 7-23 times faster
-    (measured the same day), so none is made.
+    anything is said.  Plants that fail the Riccati assumptions (singular ``D12`` or
+    ``D21``) are not checked, nor is anything said where SLICOT or the certificate
+    fails: a check never fails the synthesis.  Only the reported optimum is at stake: a
+    second γ minimisation and controller LMI at 40 states cost 13-26 s for a controller
+    certified 0.15 % lower, with poles 7-23 times faster (measured the same day), so
+    none is made.
     """
     level = gamma_lower / (1.0 + opts.gamma_relax)
     if _lmi.riccati_frame(Ps, level * sc.gamma_factor) is None:
@@ -632,9 +633,9 @@ def _riccati_beats(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling,
     try:
         check_riccati_assumptions(G)
         K, _ = _sb10ad(G, level)
-    except (AssumptionError, InfeasibleError, SolverError):
+        gamma, _ = hinfnorm(lft(G, K))
+    except (LmiSuspensionError, ValueError, ArithmeticError, np.linalg.LinAlgError):
         return None
-    gamma, _ = hinfnorm(lft(G, K))
     return (level, float(gamma)) if gamma < gamma_lower else None
 
 
