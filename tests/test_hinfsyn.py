@@ -953,3 +953,21 @@ def test_a_failing_riccati_check_says_nothing(monkeypatch, failure):
     assert res.gamma_lower == ref.gamma_lower
     assert res.gamma == ref.gamma
     assert not any("SLICOT's Riccati controller" in w for w in res.warnings)
+
+
+def test_a_riccati_controller_that_does_not_beat_the_optimum_says_nothing(monkeypatch):
+    """The cue made to fire and SLICOT made to return a controller that does not beat
+    the LMI optimum (injected: the LMI route's own controller, which certifies at or
+    above ``gamma_lower``; 8-state benchmark plant): nothing is withheld, the result is
+    the one without the check."""
+    import importlib
+
+    mod = importlib.import_module("lmi_suspension.synthesis.hinfsyn")
+    P = _bench_plant(8)
+    ref = hinfsyn(P, 4, 4)
+    assert ref.gamma >= ref.gamma_lower  # the injected controller does not beat it
+    monkeypatch.setattr(mod._lmi, "riccati_frame", lambda Ps, gamma: object())
+    monkeypatch.setattr(mod, "_sb10ad", lambda G, gamma: (ref.K, gamma))
+    res = hinfsyn(P, 4, 4)
+    assert res.gamma_lower == ref.gamma_lower
+    assert not any("SLICOT's Riccati controller" in w for w in res.warnings)
