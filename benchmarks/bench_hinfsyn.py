@@ -1,5 +1,10 @@
-"""LMI (controller SDP, or explicit formulas: ``lmi_explicit``) vs Riccati (python-control)
-vs dkpy H∞ synthesis: wall time and certified γ.
+"""LMI vs Riccati (python-control) vs dkpy H∞ synthesis: wall time and certified γ.
+
+The LMI route three ways: ``lmi``, the defaults (the structured γ minimisation, the
+explicit controller where it passes its checks); ``lmi_sdp``, the same γ minimisation
+with the controller LMI (``controller="sdp"``); ``lmi_clarabel``, the γ minimisation by
+Clarabel and the controller LMI (``gamma_solver="clarabel", controller="sdp"``, the
+defaults until 2026-11-29).
 
 Run: ``python -m pytest benchmarks/bench_hinfsyn.py --benchmark-only -p no:cacheprovider``.
 Each case runs once (pedantic, one round): the solves take seconds.  Every controller,
@@ -41,7 +46,13 @@ def _run_dkpy(P):
     return K, float(gam)
 
 
-@pytest.mark.parametrize("method", ["lmi", "lmi_explicit", "riccati", "dkpy"])
+#: the LMI variants' options (``lmi``: the defaults)
+LMI_VARIANTS = {"lmi": HinfsynOptions(),
+                "lmi_sdp": HinfsynOptions(controller="sdp"),
+                "lmi_clarabel": HinfsynOptions(gamma_solver="clarabel", controller="sdp")}
+
+
+@pytest.mark.parametrize("method", [*LMI_VARIANTS, "riccati", "dkpy"])
 @pytest.mark.parametrize("n", ORDERS)
 def test_hinfsyn(benchmark, n, method):
     if method == "dkpy" and n > DKPY_MAX_ORDER:
@@ -53,9 +64,8 @@ def test_hinfsyn(benchmark, n, method):
         try:
             if method == "dkpy":
                 return _run_dkpy(P)
-            if method == "lmi_explicit":  # the controller by explicit formulas
-                return hinfsyn(P, P.ny, P.nu, method="lmi",
-                               options=HinfsynOptions(controller="explicit"))
+            if method in LMI_VARIANTS:
+                return hinfsyn(P, P.ny, P.nu, method="lmi", options=LMI_VARIANTS[method])
             return hinfsyn(P, P.ny, P.nu, method=method)
         except (LmiSuspensionError, ValueError, np.linalg.LinAlgError) as exc:
             # record failures instead of aborting the run

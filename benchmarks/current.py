@@ -84,10 +84,10 @@ def _seconds(bench: dict) -> float:
 def _hinfsyn_entry(benches: list[dict]) -> dict:
     by = {(b["extra_info"]["n"], b["extra_info"]["method"]): b for b in benches}
     orders = sorted({n for n, _ in by})
-    methods = [m for m in ("lmi", "lmi_explicit", "riccati", "dkpy")
+    methods = [m for m in ("lmi", "lmi_explicit", "lmi_sdp", "lmi_clarabel", "riccati", "dkpy")
                if any(k[1] == m for k in by)]
-    label = {"lmi": "LMI", "lmi_explicit": "LMI explicit", "riccati": "Riccati",
-             "dkpy": "dkpy"}
+    label = {"lmi": "LMI", "lmi_explicit": "LMI explicit", "lmi_sdp": "LMI controller SDP",
+             "lmi_clarabel": "LMI Clarabel", "riccati": "Riccati", "dkpy": "dkpy"}
     columns = ["n"] + [f"{label[m]} [s]" for m in methods] + ["LMI/Riccati"]
     columns += [f"certified γ {label[m]}" for m in methods]
     no_dkpy = [n for n in orders if (n, "dkpy") not in by]
@@ -114,6 +114,8 @@ def _hinfsyn_entry(benches: list[dict]) -> dict:
                 status = b["extra_info"].get("status")
                 if m == "lmi_explicit" and status is not None and status != "explicit":
                     cell += f" (status {status}: the controller LMI's)"
+                if m == "lmi" and status == "explicit" and "lmi_sdp" in methods:
+                    cell += " (explicit)"
                 row.append(cell)
         rows.append(row)
     return {"id": "hinfsyn",
@@ -127,7 +129,12 @@ def _hinfsyn_entry(benches: list[dict]) -> dict:
                      else "") +
                     ("; LMI explicit: HinfsynOptions(controller=\"explicit\"), the "
                      "controller LMI's controller where the explicit formulas fail their "
-                     "check (status shown)" if "lmi_explicit" in methods else ""),
+                     "check (status shown)" if "lmi_explicit" in methods else "") +
+                    ("; LMI: the defaults (structured γ minimisation, explicit controller "
+                     "where it passes its checks: marked), LMI controller SDP: "
+                     "controller=\"sdp\", LMI Clarabel: gamma_solver=\"clarabel\", "
+                     "controller=\"sdp\" (the defaults until 2026-11-29)"
+                     if "lmi_clarabel" in methods else ""),
             "columns": columns, "rows": rows}
 
 

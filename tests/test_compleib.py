@@ -80,16 +80,18 @@ def test_compleib_certified_gamma(name):
 def test_compleib_ac4_against_riccati():
     """AC4 is regular (D12, D21 full rank), so python-control's Riccati hinfsyn applies;
     its controller, certified here by hinfnorm(lft(P, K)), bounds the optimum from
-    above: the LMI lower bound must not exceed it (measured 2026-11-27: 0.55729080
-    against 0.55729070, 1.8e-7 above: the solver's accuracy, hence the 1e-6) and the LMI
-    controller must certify within the 0.1 % budget of it (0.5572951)."""
+    above: the LMI lower bound must not exceed it by more than the solver's accuracy
+    and the cost of the bound ``trace(X) + trace(Y) <= xy_bound n`` (measured
+    2026-11-29: 0.5572915 against 0.5572907, 1.5e-6 above; 0.5572908 with a bound a
+    thousand times wider; hence 1e-5) and the LMI controller must certify within the
+    0.1 % budget of it (0.5572951)."""
     P = load("AC4")
     K, _CL, _gam, _ = control.hinfsyn(P.sys, P.ny, P.nu)
     best = hinfnorm(lft(P, K))[0]
     assert np.isfinite(best)
     res = hinfsyn(P, P.ny, P.nu)
     assert np.all(np.real(res.poles) < 0)
-    assert res.gamma_lower <= best * (1 + 1e-6)
+    assert res.gamma_lower <= best * (1 + 1e-5)
     assert best * (1 - 1e-6) <= res.gamma <= best * (1 + DEFAULT_BUDGET)
     assert not any("below the LMI optimum" in w for w in res.warnings)
 

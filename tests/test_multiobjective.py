@@ -54,9 +54,11 @@ def test_hinf_objective_alone_is_hinfsyns_lmi_optimum(name):
     if name == "AC4":
         # the one regular plant: python-control's Riccati controller, certified here, is
         # a reference outside the LMI routes (0.55729070, measured 2026-11-27; msyn's LMI
-        # optimum 0.5572963); issue 41 reported hinfsyn's optimum above it on AC4
+        # optimum 0.5572963); issue 41 reported hinfsyn's optimum above it on AC4.
+        # hinfsyn's is 0.5572915 since 2026-11-29, above it by the cost of the trace
+        # bound (test_compleib_ac4_against_riccati), hence 1e-5
         best = hinfnorm(lft(P, control.hinfsyn(P.sys, P.ny, P.nu)[0]))[0]
-        assert ref <= best * (1 + 1e-6) and info.objective_lmi <= best * (1 + 1e-4)
+        assert ref <= best * (1 + 1e-5) and info.objective_lmi <= best * (1 + 1e-4)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

@@ -799,7 +799,7 @@ def test_lmi_k_step_at_the_level_of_a_certified_controller():
                       kwargs["options"].controller))
         return _hinfsyn(*args, **kwargs)
 
-    own = HinfsynOptions(riccati_search="bisection")  # controller="sdp", its default
+    own = HinfsynOptions(riccati_search="bisection", controller="sdp")
     for opts, route in ((MusynOptions(), "explicit"),
                         (MusynOptions(hinfsyn_options=own), "sdp")):
         res = _k_step(spy, PD, nmeas, ncon, opts, 2.0)

@@ -321,11 +321,14 @@ def _central_start(hinfsyn, P, nmeas: int, ncon: int, opts, syn):
 
 
 def _kstep_options(opts):
-    """The options of every K-step: the user's, or the bisection Riccati search."""
+    """The options of every K-step: the user's, or the bisection Riccati search with the
+    controller LMI after a γ minimisation (``controller="sdp"``: at the γ optimum of
+    a D-scaled plant the explicit formulas' poles are fast; the K-step at a fixed level
+    takes ``_LEVEL_LED_CONTROLLER`` instead)."""
     from ...synthesis import HinfsynOptions
 
     return (opts.hinfsyn_options if opts.hinfsyn_options is not None
-            else HinfsynOptions(riccati_search="bisection"))
+            else HinfsynOptions(riccati_search="bisection", controller="sdp"))
 
 
 def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base, controller: str = "sdp"):

@@ -1,0 +1,227 @@
+"""The γ minimisation by CVXOPT with the structured KKT solver (synthesis/structured.py).
+
+Every figure here is checked against a computation that did not produce it: the Schur
+complement against the Gram matrix of the constraint columns scaled by CVXOPT's own
+``misc.scale`` and multiplied by its own ``misc.sdot``; the KKT solve against the KKT
+equations it must satisfy; the optimum against Clarabel's solve of the same LMIs through
+CVXPY, and against SLICOT's Riccati level on a regular plant.
+"""
+
+import dataclasses
+import importlib
+import sys
+from pathlib import Path
+
+import cvxopt
+import numpy as np
+import pytest
+from cvxopt import misc
+
+from lmi_suspension.errors import ParameterError, SolverError
+from lmi_suspension.examples import compleib
+from lmi_suspension.lti.scaling import scale_plant
+from lmi_suspension.synthesis import HinfsynOptions, lmi
+from lmi_suspension.synthesis.hinfsyn import riccati_level
+
+structured = importlib.import_module("lmi_suspension.synthesis.structured")
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "benchmarks"))
+from bench_hinfsyn import plant  # noqa: E402
+
+OPTS = HinfsynOptions()
+
+
+def _problem(P, n=None):
+    """The structured problem of ``gamma_lmi``'s first minimisation (identity frame)."""
+    Ps, _ = scale_plant(P)
+    n = Ps.nstates
+    proj_r, proj_s = lmi._projections(*lmi.Frame.identity(n).plants(Ps), True)
+    ineqs = [structured._Inequality.from_projection(p, n, of_s)
+             for p, of_s in ((proj_r, False), (proj_s, True)) if p is not None]
+    M = proj_r.T.T @ proj_s.T
+    return structured._GammaProblem(ineqs, M, OPTS.xy_bound * n, OPTS.margin), Ps
+
+
+def _random_scaling(prob, rng):
+    """A CVXOPT scaling ``W`` with well-conditioned random ``r`` of each PSD block."""
+    r = [rng.standard_normal((k, k)) + 3.0 * np.eye(k) for k in prob.dims["s"]]
+    d = rng.uniform(0.5, 2.0, prob.dims["l"])
+    return {"d": cvxopt.matrix(d), "di": cvxopt.matrix(1.0 / d), "beta": [], "v": [],
+            "r": [cvxopt.matrix(x) for x in r],
+            "rti": [cvxopt.matrix(np.linalg.inv(x).T) for x in r]}
+
+
+def _columns(prob):
+    """The columns of ``G``, one application of the operator per unit vector."""
+    cdim = int(prob.h.size[0])
+    cols = []
+    for j in range(prob.m):
+        e = cvxopt.matrix(0.0, (prob.m, 1))
+        e[j] = 1.0
+        v = cvxopt.matrix(0.0, (cdim, 1))
+        prob.G(e, v)
+        cols.append(v)
+    return cols
+
+
+def _random_cone_vector(prob, rng):
+    """A vector of the cone space whose PSD blocks are symmetric."""
+    parts = [rng.standard_normal(prob.dims["l"])]
+    for k in prob.dims["s"]:
+        Z = rng.standard_normal((k, k))
+        parts.append((Z + Z.T).ravel(order="F"))
+    return cvxopt.matrix(np.concatenate(parts))
+
+
+@pytest.fixture(scope="module")
+def small():
+    """COMPleib AC4 (4 states): both projections non-trivial."""
+    return _problem(compleib("AC4"))
+
+
+def test_the_schur_complement_is_the_gram_matrix_of_the_scaled_columns(small):
+    prob, _ = small
+    W = _random_scaling(prob, np.random.default_rng(7))
+    M, _f = prob.schur(W)
+    scaled = []
+    for g in _columns(prob):
+        misc.scale(g, W, trans="T", inverse="I")  # W⁻ᵀ g, CVXOPT's own routine
+        scaled.append(g)
+    gram = np.array([[misc.sdot(a, b, prob.dims) for b in scaled] for a in scaled])
+    assert np.allclose(M, gram, rtol=1e-10, atol=1e-10 * np.abs(gram).max())
+
+
+def test_the_operator_and_its_adjoint_agree(small):
+    prob, _ = small
+    rng = np.random.default_rng(11)
+    x = cvxopt.matrix(rng.standard_normal(prob.m))
+    v = _random_cone_vector(prob, rng)
+    Gx = cvxopt.matrix(0.0, v.size)
+    prob.G(x, Gx)
+    GTv = cvxopt.matrix(0.0, x.size)
+    prob.G(v, GTv, trans="T")
+    lhs = misc.sdot(Gx, v, prob.dims)  # CVXOPT's inner product of the cone space
+    assert lhs == pytest.approx(float(np.dot(np.array(x).ravel(), np.array(GTv).ravel())),
+                                rel=1e-12)
+
+
+@pytest.mark.parametrize("ill", [False, True], ids=["factorised", "regularised"])
+def test_the_kkt_solve_satisfies_the_kkt_equations(small, monkeypatch, ill):
+    """``f(x, y, z)`` must return ``ux`` and ``W uz`` with ``Gᵀ uz = bx`` and
+    ``G ux - Wᵀ W uz = bz`` (CVXOPT's conelp docstring).  ``ill``: the unregularised
+    factorisation is made to fail (injected), so the solve runs on the regularised
+    complement with iterative refinement and must still meet the equations."""
+    prob, _ = small
+    if ill:
+        real = structured.scipy.linalg.cho_factor
+
+        def refuse_plain(M, **kw):
+            if prob._level == 0 and not getattr(refuse_plain, "done", False):
+                refuse_plain.done = True
+                raise np.linalg.LinAlgError("injected")
+            return real(M, **kw)
+
+        monkeypatch.setattr(structured.scipy.linalg, "cho_factor", refuse_plain)
+    rng = np.random.default_rng(3)
+    W = _random_scaling(prob, rng)
+    f = prob.kktsolver(W)
+    assert prob.regularised == int(ill)
+    bx = cvxopt.matrix(rng.standard_normal(prob.m))
+    bz = _random_cone_vector(prob, rng)
+    x, z = cvxopt.matrix(bx), cvxopt.matrix(bz)
+    f(x, cvxopt.matrix(0.0, (0, 1)), z)
+    uz = cvxopt.matrix(z)  # z holds W uz: uz = W⁻¹ z
+    misc.scale(uz, W, inverse="I")
+    GTuz = cvxopt.matrix(0.0, bx.size)
+    prob.G(uz, GTuz, trans="T")
+    Gux = cvxopt.matrix(0.0, bz.size)
+    prob.G(x, Gux)
+    WTWuz = cvxopt.matrix(uz)
+    misc.scale(WTWuz, W)
+    misc.scale(WTWuz, W, trans="T")
+    # residuals relative to the right-hand sides (sdot norms of the cone space)
+    rx = np.linalg.norm(np.array(GTuz - bx)) / np.linalg.norm(np.array(bx))
+    res_z = Gux - WTWuz - bz
+    rz = np.sqrt(misc.sdot(res_z, res_z, prob.dims) / misc.sdot(bz, bz, prob.dims))
+    assert rx < 1e-8 and rz < 1e-8
+
+
+@pytest.mark.parametrize("name", ["AC4", "HE1", "REA2", "NN2"])
+def test_the_optimum_is_feasible_and_not_above_clarabels(name):
+    """The same LMIs solved by Clarabel through CVXPY: an interior-point method stops
+    above the optimum by its tolerance, or further where its iterates stall (Clarabel's
+    first minimisation on AC4: 0.560661 against 0.557292 here, in the plant's units,
+    where SLICOT's controller certifies 0.5572907; measured 2026-11-29), so the
+    structured optimum may be below Clarabel's, but not above it by more than the two
+    solvers' tolerances (1e-5 here).  Below it, the solution must be feasible: each
+    projected inequality and the coupling are evaluated here, at the returned ``(R, S)``
+    and γ, by CVXPY's expressions of :mod:`.lmi`."""
+    Ps, _ = scale_plant(compleib(name))
+    fast = lmi.gamma_lmi(Ps, OPTS)
+    ref = lmi.gamma_lmi(Ps, dataclasses.replace(OPTS, gamma_solver="clarabel"))
+    assert fast.status == "optimal" and not fast.warnings
+    assert fast.gamma <= ref.gamma * (1 + 1e-5)
+    n = Ps.nstates
+    for p, X in zip(lmi._projections(*lmi.Frame.identity(n).plants(Ps), True),
+                    (fast.R, fast.S)):
+        if p is not None:
+            L = p.matrix(p.T.T @ X @ p.T, fast.gamma).value
+            assert np.linalg.eigvalsh(L)[-1] <= 0.0
+    C = np.block([[fast.R, np.eye(n)], [np.eye(n), fast.S]])
+    # the coupling holds up to CVXOPT's feasibility tolerance (1e-8, relative)
+    assert np.linalg.eigvalsh(C)[0] >= -1e-8 * np.abs(C).max()
+
+
+def test_a_regular_plants_optimum_is_slicots_level():
+    """On the 8-state regular benchmark plant the LMI optimum is the Riccati optimum:
+    SLICOT's level (``riccati_level``, bisected to 1e-6) must agree with it within
+    the trace bound's measured cost (below ``gamma_relax / 10``, see ``lmi.py``) and
+    the bisection's width."""
+    P = plant(8)
+    Ps, sc = scale_plant(P)
+    sol = lmi.gamma_lmi(Ps, OPTS)
+    level = riccati_level(P, 4, 4, HinfsynOptions(riccati_rtol=1e-6))
+    assert sol.gamma / sc.gamma_factor == pytest.approx(level, rel=OPTS.gamma_relax / 10)
+
+
+def test_a_failed_structured_solve_falls_back_to_clarabel(monkeypatch):
+    """Injected: CVXOPT's conelp ends with status "unknown" far from the optimum.
+    ``minimise_gamma`` must raise, and ``gamma_lmi`` must return Clarabel's solution
+    with a warning that says so."""
+    real = cvxopt.solvers.conelp
+
+    def stalls(*args, **kwargs):
+        sol = real(*args, **{**kwargs, "options": {**kwargs["options"], "maxiters": 2}})
+        return {**sol, "status": "unknown"}
+
+    monkeypatch.setattr(structured.cvxopt.solvers, "conelp", stalls)
+    Ps, _ = scale_plant(compleib("AC4"))
+    sol = lmi.gamma_lmi(Ps, OPTS)
+    ref = lmi.gamma_lmi(Ps, dataclasses.replace(OPTS, gamma_solver="clarabel"))
+    assert sol.gamma == ref.gamma
+    assert any("structured γ minimisation: CVXOPT status 'unknown'" in w
+               and "solved by Clarabel" in w for w in sol.warnings)
+
+
+def test_a_singular_schur_complement_ends_the_solve_with_a_solver_error(monkeypatch):
+    """Injected: every factorisation fails, regularised or not.  CVXOPT ends at its
+    first iterate; ``minimise_gamma`` raises :class:`SolverError` (never returns the
+    iterate), and ``gamma_lmi`` falls back."""
+
+    def singular(M, **kw):
+        raise np.linalg.LinAlgError("injected")
+
+    monkeypatch.setattr(structured.scipy.linalg, "cho_factor", singular)
+    prob, Ps = _problem(compleib("AC4"))
+    n = Ps.nstates
+    proj_r, proj_s = lmi._projections(*lmi.Frame.identity(n).plants(Ps), True)
+    with pytest.raises(SolverError, match="structured γ minimisation"):
+        structured.minimise_gamma([(proj_r, False), (proj_s, True)], proj_r.T.T @ proj_s.T,
+                                  OPTS.xy_bound * n, OPTS.margin, OPTS)
+    sol = lmi.gamma_lmi(Ps, OPTS)
+    assert any("solved by Clarabel" in w for w in sol.warnings)
+
+
+def test_gamma_solver_is_checked():
+    with pytest.raises(ParameterError, match="gamma_solver"):
+        HinfsynOptions(gamma_solver="mosek")
