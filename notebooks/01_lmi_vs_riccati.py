@@ -27,7 +27,8 @@
 # * **LMI** (`hinfsyn(..., method="lmi")`): minimises γ over the projected (elimination) LMIs
 #   in $X, Y$ (CVXOPT's interior-point method with a KKT solver that uses the LMIs' Lyapunov
 #   structure; Clarabel where it fails); it gives a *lower bound* `gamma_lower` valid for every controller
-#   up to the solver's accuracy (withheld where a certified Riccati controller beats it),
+#   up to the solver's accuracy and the cost of a bound on $X, Y$ that keeps the problem
+#   bounded (withheld where a certified Riccati controller beats it),
 #   then reconstructs a well-conditioned controller at a slightly relaxed γ. It needs none of
 #   the rank assumptions.
 #

@@ -29,13 +29,15 @@ sys.path.insert(0, str(Path(__file__).parents[1] / "benchmarks"))
 from bench_hinfsyn import plant  # noqa: E402
 
 OPTS = HinfsynOptions()
+#: the factorisation the injections wrap (captured once: an injection may replace another)
+_CHO_FACTOR = structured.scipy.linalg.cho_factor
 
 
-def _problem(P, n=None):
+def _problem(P, sparse=True):
     """The structured problem of ``gamma_lmi``'s first minimisation (identity frame)."""
     Ps, _ = scale_plant(P)
     n = Ps.nstates
-    proj_r, proj_s = lmi._projections(*lmi.Frame.identity(n).plants(Ps), True)
+    proj_r, proj_s = lmi._projections(*lmi.Frame.identity(n).plants(Ps), sparse)
     ineqs = [structured._Inequality.from_projection(p, n, of_s)
              for p, of_s in ((proj_r, False), (proj_s, True)) if p is not None]
     M = proj_r.T.T @ proj_s.T
@@ -73,7 +75,7 @@ def _random_cone_vector(prob, rng):
     return cvxopt.matrix(np.concatenate(parts))
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def small():
     """COMPleib AC4 (4 states): both projections non-trivial."""
     return _problem(compleib("AC4"))
@@ -98,30 +100,31 @@ def test_the_operator_and_its_adjoint_agree(small):
     v = _random_cone_vector(prob, rng)
     Gx = cvxopt.matrix(0.0, v.size)
     prob.G(x, Gx)
+    # CVXOPT reads only the lower triangle of each block: what is above it must not count
+    off, garbage = prob.dims["l"], np.array(v).ravel()
+    for k in prob.dims["s"]:
+        block = garbage[off: off + k * k].reshape(k, k, order="F")
+        block[np.triu_indices(k, 1)] = rng.standard_normal(k * (k - 1) // 2)
+        garbage[off: off + k * k] = block.ravel(order="F")
+        off += k * k
     GTv = cvxopt.matrix(0.0, x.size)
-    prob.G(v, GTv, trans="T")
+    prob.G(cvxopt.matrix(garbage), GTv, trans="T")
     lhs = misc.sdot(Gx, v, prob.dims)  # CVXOPT's inner product of the cone space
     assert lhs == pytest.approx(float(np.dot(np.array(x).ravel(), np.array(GTv).ravel())),
                                 rel=1e-12)
 
 
 @pytest.mark.parametrize("ill", [False, True], ids=["factorised", "regularised"])
-def test_the_kkt_solve_satisfies_the_kkt_equations(small, monkeypatch, ill):
+def test_the_kkt_solve_satisfies_the_kkt_equations(small, ill):
     """``f(x, y, z)`` must return ``ux`` and ``W uz`` with ``Gᵀ uz = bx`` and
-    ``G ux - Wᵀ W uz = bz`` (CVXOPT's conelp docstring).  ``ill``: the unregularised
-    factorisation is made to fail (injected), so the solve runs on the regularised
-    complement with iterative refinement and must still meet the equations."""
+    ``G ux - Wᵀ W uz = bz`` (CVXOPT's conelp docstring).  ``ill``: the complement is
+    factorised with the ladder's largest regularisation (as after failed
+    factorisations near an optimum), so only the iterative refinement against the
+    unregularised complement brings ``Gᵀ uz`` back to ``bx`` (without it the residual
+    was 7.6e-3 here, with it 6.9e-10; measured 2026-11-29)."""
     prob, _ = small
     if ill:
-        real = structured.scipy.linalg.cho_factor
-
-        def refuse_plain(M, **kw):
-            if prob._level == 0 and not getattr(refuse_plain, "done", False):
-                refuse_plain.done = True
-                raise np.linalg.LinAlgError("injected")
-            return real(M, **kw)
-
-        monkeypatch.setattr(structured.scipy.linalg, "cho_factor", refuse_plain)
+        prob._level = len(structured._REGULARISATION) - 1
     rng = np.random.default_rng(3)
     W = _random_scaling(prob, rng)
     f = prob.kktsolver(W)
@@ -204,9 +207,9 @@ def test_a_failed_structured_solve_falls_back_to_clarabel(monkeypatch):
 
 
 def test_a_singular_schur_complement_ends_the_solve_with_a_solver_error(monkeypatch):
-    """Injected: every factorisation fails, regularised or not.  CVXOPT ends at its
-    first iterate; ``minimise_gamma`` raises :class:`SolverError` (never returns the
-    iterate), and ``gamma_lmi`` falls back."""
+    """Injected: every factorisation fails, regularised or not.  conelp raises at its
+    initialisation (ValueError); ``minimise_gamma`` raises :class:`SolverError`, and
+    ``gamma_lmi`` falls back to Clarabel."""
 
     def singular(M, **kw):
         raise np.linalg.LinAlgError("injected")
@@ -225,3 +228,85 @@ def test_a_singular_schur_complement_ends_the_solve_with_a_solver_error(monkeypa
 def test_gamma_solver_is_checked():
     with pytest.raises(ParameterError, match="gamma_solver"):
         HinfsynOptions(gamma_solver="mosek")
+
+
+def _factorisations(monkeypatch, fail_from):
+    """Count the Schur complement's factorisations; fail every one from ``fail_from`` on
+    (None: none), as near-singular complements do."""
+    real, count = _CHO_FACTOR, [0]
+
+    def counted(M, **kw):
+        count[0] += 1
+        if fail_from is not None and count[0] >= fail_from:
+            raise np.linalg.LinAlgError("injected")
+        return real(M, **kw)
+
+    monkeypatch.setattr(structured.scipy.linalg, "cho_factor", counted)
+    return count
+
+
+def _minimise(P):
+    Ps, _ = scale_plant(P)
+    n = Ps.nstates
+    proj_r, proj_s = lmi._projections(*lmi.Frame.identity(n).plants(Ps), True)
+    return structured.minimise_gamma([(proj_r, False), (proj_s, True)],
+                                     proj_r.T.T @ proj_s.T, OPTS.xy_bound * n, OPTS.margin,
+                                     OPTS)
+
+
+def test_a_run_stopped_near_the_optimum_is_optimal_inaccurate(monkeypatch):
+    """Injected: the factorisations fail from the last iteration of an undisturbed run
+    on (counted here, in the same process), so CVXOPT stops one iteration short with
+    status "unknown".  That iterate is within the reduced tolerances: it is returned as
+    "optimal_inaccurate", within ``reduced_tol_gap_rel`` of the undisturbed optimum, and
+    ``gamma_lmi`` says so in its warnings."""
+    count = _factorisations(monkeypatch, None)
+    full = _minimise(compleib("AC4"))
+    last = count[0]
+    _factorisations(monkeypatch, last)
+    short = _minimise(compleib("AC4"))
+    assert full.status == "optimal" and short.status == "optimal_inaccurate"
+    assert short.iterations < full.iterations
+    assert short.gamma == pytest.approx(full.gamma, rel=OPTS.reduced_tol_gap_rel)
+    _factorisations(monkeypatch, last)  # the same problem, counted afresh
+    Ps, _ = scale_plant(compleib("AC4"))
+    sol = lmi.gamma_lmi(Ps, OPTS)
+    assert sol.status == "optimal_inaccurate"
+    assert any("CVXOPT stopped short" in w for w in sol.warnings)
+
+
+def test_a_run_stopped_far_from_the_optimum_is_a_solver_error(monkeypatch):
+    """Injected: the factorisations fail from the fifth on, far from the optimum; the
+    iterate is outside the reduced tolerances and is never returned."""
+    _factorisations(monkeypatch, 5)
+    with pytest.raises(SolverError, match="status 'unknown'"):
+        _minimise(compleib("AC4"))
+
+
+@pytest.mark.parametrize("sparse", [True, False], ids=["sparse", "plain"])
+@pytest.mark.parametrize("name", ["AC4", "HE1"])
+def test_the_operator_is_the_projected_inequalities(name, sparse):
+    """``G x`` against CVXPY's expressions of the same inequalities
+    (``_Projection.matrix``, evaluated at random ``R̃``, ``S̃``, γ): HE1's sparse form
+    pads ``E`` (5 columns, rank 3)."""
+    prob, Ps = _problem(compleib(name), sparse)
+    n = Ps.nstates
+    projs = lmi._projections(*lmi.Frame.identity(n).plants(Ps), sparse)
+    rng = np.random.default_rng(5)
+    x = rng.standard_normal(prob.m)
+    Gx = prob._apply(x, prob._plain)
+    Rt, St, g = prob.basis.matrix(x[: prob.nv]), prob.basis.matrix(x[prob.nv: -1]), x[-1]
+    off = prob.dims["l"]
+    for p, X in zip(projs, (Rt, St)):
+        if p is None:
+            continue
+        k = p.H.shape[0] + p.H.shape[1]
+        # G x = L(X, γ) - H̄: the linear part of the projected matrix
+        L = p.matrix(X, g).value - p.matrix(np.zeros_like(X), 0.0).value
+        np.testing.assert_allclose(Gx[off: off + k * k].reshape(k, k, order="F"), L,
+                                   atol=1e-12 * max(1.0, np.abs(L).max()))
+        off += k * k
+    C = Gx[off:].reshape(2 * n, 2 * n, order="F")
+    np.testing.assert_array_equal(C[:n, :n], -Rt)
+    np.testing.assert_array_equal(C[n:, n:], -St)
+    assert not C[:n, n:].any()

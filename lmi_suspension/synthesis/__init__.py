@@ -1,4 +1,4 @@
-"""Controller synthesis: certified H∞ by LMIs (Clarabel) or Riccati (python-control), and
+"""Controller synthesis: certified H∞ by LMIs (CVXOPT, Clarabel) or Riccati (python-control), and
 multi-objective LMI synthesis (H∞, H2, peak bounds, pole regions; :func:`msyn`, and
 static state feedback :func:`msfsyn`).
 

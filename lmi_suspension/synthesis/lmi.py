@@ -1,4 +1,5 @@
-"""Full-order H∞ synthesis by LMIs (projection lemma), solved by Clarabel through CVXPY.
+"""Full-order H∞ synthesis by LMIs (projection lemma): the γ minimisation by CVXOPT with a
+KKT solver for its structure (:mod:`.structured`), every other LMI by Clarabel through CVXPY.
 
 The existence of a controller with ``||F_l(P, K)||_∞ < γ`` (Gahinet & Apkarian 1994,
 Theorem 4.3; ``D22 = 0``) is equivalent to symmetric ``R`` and ``S`` with::
@@ -349,15 +350,19 @@ def gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None = N
     ``P`` must have ``D22 = 0`` and should be scaled.  With a ``frame`` (from an earlier
     solution) the Lyapunov variables are written relative to it (:class:`Frame`); the
     bound ``trace + trace <= xy_bound n`` then applies to the relative variables.  The
-    sparse form (:class:`_Projection`) is solved first; where Clarabel fails on it,
-    the plain form.  ``R`` and ``S`` are returned in the coordinates of ``P``.
+    minimisation is solved by :func:`.structured.minimise_gamma` (``opts.gamma_solver ==
+    "structured"``), by Clarabel where that fails (said in ``warnings``) or where asked
+    to, and every fixed-level problem by Clarabel.  The sparse form (:class:`_Projection`)
+    is solved first; where both fail on it, the plain form.  ``R`` and ``S`` are returned
+    in the coordinates of ``P``.
 
     Raises
     ------
     InfeasibleError
         If no controller achieves the fixed ``gamma`` (or none stabilises ``P``).
     SolverError
-        If Clarabel fails after ``opts.max_recoveries`` recoveries on both forms.
+        If Clarabel fails after ``opts.max_recoveries`` recoveries on both forms (the
+        structured solve having failed before it).
     """
     frame = Frame.identity(P.nstates) if frame is None else frame
     try:
@@ -401,8 +406,11 @@ def _gamma_lmi(P: GeneralizedPlant, opts: HinfsynOptions, gamma: float | None,
             # of γ against a measured 3.9e-5 for a bound ten times wider, 2026-11-29)
             bound = opts.xy_bound * n
             costly = found.trace_multiplier * bound > 0.1 * opts.gamma_relax * found.gamma
+            said = [] if found.status == "optimal" else [
+                f"gamma minimisation: CVXOPT stopped short of its tolerances ({found.status!r}, "
+                "within the reduced ones); the result is certified independently"]
             return _lmi_solution(found.gamma, found.Rt, found.St, U_r, U_s, frame, opts,
-                                 found.status, [], trace_active=costly)
+                                 found.status, said, trace_active=costly)
     cons = [p.lmi(V, g, opts.margin) for p, V in ((proj_r, Rt), (proj_s, St)) if p is not None]
     cons += [_sym(cp.bmat([[Rt, M], [M.T, St]])) >> 0,
              cp.trace(Rt) + cp.trace(St) <= opts.xy_bound * n]  # rotations keep traces

@@ -38,9 +38,10 @@ class HinfsynOptions:
         Clarabel tolerances (passed explicitly), and CVXOPT's ``abstol``, ``reltol``,
         ``feastol`` in the structured γ minimisation (``gamma_solver``).
     reduced_tol_gap_abs, reduced_tol_gap_rel, reduced_tol_feas : float
-        Clarabel's "almost solved" tolerances: a solve that stalls within them is
-        accepted as ``optimal_inaccurate`` (reported in ``warnings``); γ only needs to
-        be accurate to a fraction of ``gamma_relax``.
+        "Almost solved" tolerances (Clarabel's, and the structured γ minimisation's
+        relative gap and feasibility): a solve that stalls within them is accepted as
+        ``optimal_inaccurate`` (reported in ``warnings``); γ only needs to be accurate to
+        a fraction of ``gamma_relax``.
     max_iter : int
         Iteration bound per solve (Clarabel's and CVXOPT's).
     margin : float

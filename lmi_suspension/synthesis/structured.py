@@ -60,14 +60,17 @@ _REFINEMENT_STEPS = 3
 class StructuredSolution:
     """Optimum of the γ minimisation: ``gamma`` and the relative Lyapunov variables
     ``Rt``, ``St`` of the projections' coordinates, CVXOPT's ``status`` ("optimal", or
-    "optimal_inaccurate" for a run that stopped within the reduced tolerances), its
-    ``iterations``, and how many of them needed a regularised Schur complement."""
+    "optimal_inaccurate" for a run that stopped short of its tolerances but within the
+    reduced ones, ``reduced_tol_gap_rel`` and ``reduced_tol_feas``: a γ near 0, whose
+    relative gap CVXOPT does not define, is never accepted so), its ``iterations``, and
+    how many factorisations needed a regularised Schur complement."""
 
     gamma: float
     Rt: np.ndarray
     St: np.ndarray
     status: str
     iterations: int
+    #: factorisations of the Schur complement that needed a regularisation
     regularised: int
     #: the dual multiplier of the trace bound: doubling the bound lowers γ by at most
     #: ``trace_multiplier * trace_bound`` (convexity)
@@ -331,21 +334,42 @@ def minimise_gamma(projections, coupling: np.ndarray, trace_bound: float, margin
         ``feastol``), ``max_iter``, and the reduced tolerances within which a run that
         stops short of them is accepted as "optimal_inaccurate".
 
+    Returns
+    -------
+    StructuredSolution
+        γ, the relative Lyapunov variables, the status and the solver's counts.
+
     Raises
     ------
     SolverError
         Where CVXOPT ends with neither: the caller falls back to Clarabel.
+
+    Examples
+    --------
+    Through :func:`~lmi_suspension.synthesis.lmi.gamma_lmi`, which poses the problem
+    (COMPleib AC4, scaled; SLICOT's controller certifies 0.5572907 in the plant's units):
+
+    >>> from lmi_suspension.examples import compleib
+    >>> from lmi_suspension.lti.scaling import scale_plant
+    >>> from lmi_suspension.synthesis import HinfsynOptions, lmi
+    >>> Ps, sc = scale_plant(compleib("AC4"))
+    >>> sol = lmi.gamma_lmi(Ps, HinfsynOptions())
+    >>> sol.status, round(sol.gamma / sc.gamma_factor, 5)
+    ('optimal', 0.55729)
     """
     n = coupling.shape[0]
-    ineqs = [_Inequality.from_projection(p, n, of_s) for p, of_s in projections if p is not None]
-    prob = _GammaProblem(ineqs, coupling, trace_bound, margin)
     settings = dict(show_progress=False, maxiters=int(options.max_iter),
                     abstol=float(options.tol_gap_abs), reltol=float(options.tol_gap_rel),
                     feastol=float(options.tol_feas), refinement=1)
     try:
+        ineqs = [_Inequality.from_projection(p, n, of_s)
+                 for p, of_s in projections if p is not None]
+        prob = _GammaProblem(ineqs, coupling, trace_bound, margin)
         sol = cvxopt.solvers.conelp(prob.c, prob.G, prob.h, prob.dims,
                                     kktsolver=prob.kktsolver, options=settings)
-    except (ArithmeticError, ValueError) as exc:
+    except (ArithmeticError, ValueError, MemoryError) as exc:
+        # conelp raises ValueError where its first factorisation fails; the complement
+        # takes 8 n⁴ bytes (0.8 GB at 100 states), which a small machine may not have
         raise SolverError(f"structured γ minimisation: CVXOPT failed ({exc})",
                           status="failed") from exc
     status = sol["status"]

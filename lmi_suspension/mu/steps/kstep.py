@@ -386,8 +386,9 @@ def _k_step(hinfsyn, PD, nmeas: int, ncon: int, opts,
     or below ``gamma_prev`` (the previous controller's level), it runs on a
     Gramian-balanced realization and then the LMI route follows; the controller with the
     lowest γ *certified on* ``PD`` is kept: each fails on problems another solves
-    (singular D12/D21 for Riccati; D-scaled plants with a slow weight pole, where
-    Clarabel's γ minimisation stalls and any Riccati variant can be the accurate one)."""
+    (singular D12/D21 for Riccati; D-scaled plants with a slow weight pole, where the
+    LMI's γ minimisation stalled (Clarabel's, measured 2026-11-26) and any Riccati
+    variant can be the accurate one)."""
     base = _kstep_options(opts)
     probes = KSTEP_RICCATI_PROBES  # used by the Riccati route only
     if opts.method != "best":
