@@ -51,6 +51,12 @@ logger = logging.getLogger(__name__)
 #: before the optimum on the 4-30-state benchmark plants, with 1e-13 (and the
 #: refinement below) every one of them reached CVXOPT's tolerances (measured 2026-11-29)
 _REGULARISATION = (0.0, 1e-13, 1e-11, 1e-9, 1e-7)
+#: bound on CVXOPT's iterations, below ``max_iter`` (Clarabel's bound, 200): the runs
+#: that end optimal took 12-26 (benchmark plants n = 4-60, 12 COMPleib plants), and one that
+#: stalled (the property test's plant of seed 2374001 under OpenBLAS Sandybridge) kept
+#: the same residuals from its 20th iteration to its 95th, where CVXOPT divided by
+#: zero; Clarabel then solves the problem (measured 2026-11-29)
+_MAX_ITERATIONS = 60
 #: iterative-refinement steps against the unregularised complement where a
 #: regularisation was needed (each costs two applications of the constraint map)
 _REFINEMENT_STEPS = 3
@@ -331,8 +337,9 @@ def minimise_gamma(projections, coupling: np.ndarray, trace_bound: float, margin
         Strictness margin of the inequalities.
     options : HinfsynOptions
         ``tol_gap_abs``, ``tol_gap_rel``, ``tol_feas`` (CVXOPT's ``abstol``, ``reltol``,
-        ``feastol``), ``max_iter``, and the reduced tolerances within which a run that
-        stops short of them is accepted as "optimal_inaccurate".
+        ``feastol``), ``max_iter`` (at most ``_MAX_ITERATIONS``), and the reduced
+        tolerances within which a run that stops short of them is accepted as
+        "optimal_inaccurate".
 
     Returns
     -------
@@ -358,7 +365,7 @@ def minimise_gamma(projections, coupling: np.ndarray, trace_bound: float, margin
     ('optimal', 0.55729)
     """
     n = coupling.shape[0]
-    settings = dict(show_progress=False, maxiters=int(options.max_iter),
+    settings = dict(show_progress=False, maxiters=min(int(options.max_iter), _MAX_ITERATIONS),
                     abstol=float(options.tol_gap_abs), reltol=float(options.tol_gap_rel),
                     feastol=float(options.tol_feas), refinement=1)
     try:
