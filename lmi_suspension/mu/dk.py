@@ -135,12 +135,13 @@ class MusynOptions:
         K-steps to µ 0.974-0.981 against 1.03 from the LMI's own.
     hinfsyn_options : HinfsynOptions or None
         Options passed to every K-step (default: ``HinfsynOptions`` with
-        ``riccati_search = "bisection"`` and ``controller = "sdp"`` after a γ
-        minimisation, and the LMI K-step at a fixed level builds its controller by the
-        explicit formulas where they pass their certificate and pole cap; the Riccati
-        K-steps also try the suboptimal levels ``KSTEP_RICCATI_PROBES``).  Given options
-        are used as they are: their ``controller`` (``"explicit"`` unless set) applies to
-        every LMI K-step.
+        ``riccati_search = "bisection"``, ``gamma_solver = "clarabel"`` and
+        ``controller = "sdp"`` for a γ minimisation, whose D-K path was the more
+        reproducible across OpenBLAS kernels; the LMI K-step at a fixed level builds its
+        controller by the explicit formulas where they pass their certificate and pole
+        cap; the Riccati K-steps also try the suboptimal levels
+        ``KSTEP_RICCATI_PROBES``).  Given options are used as they are: their
+        ``controller`` (``"explicit"`` unless set) applies to every LMI K-step.
     max_dfit_order : int
         Largest order of each D-scale fit.
     dfit_rtol : float

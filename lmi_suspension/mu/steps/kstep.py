@@ -71,6 +71,13 @@ _LEVEL_LED_RECOVERIES = 1
 #: controller LMI (0.959417-0.959536), in 21.9-32.9 s instead of 26.1-44.1 s (measured
 #: 2026-11-28, benchmarks/HISTORY.md)
 _LEVEL_LED_CONTROLLER = "explicit"
+#: the solver of the first LMI K-step's γ minimisation under the default K-step options.
+#: With the structured solver (``hinfsyn``'s default since 2026-11-29) default ``musyn``
+#: on distillation ended at µ 0.959009-0.960169 over the 8 OpenBLAS kernel and thread
+#: rows (above the 0.9600 target on one, a spread of 1.2e-3), with Clarabel's at
+#: 0.959417-0.959536 (stop 54); the K-steps were 0.7 s of its 11-14 s either way
+#: (measured 2026-11-29, ``../shared/tools/kernels python benchmarks/musyn_default.py``)
+_KSTEP_GAMMA_SOLVER = "clarabel"
 
 
 class HinfKStep:
@@ -321,14 +328,16 @@ def _central_start(hinfsyn, P, nmeas: int, ncon: int, opts, syn):
 
 
 def _kstep_options(opts):
-    """The options of every K-step: the user's, or the bisection Riccati search with the
-    controller LMI after a γ minimisation (``controller="sdp"``: at the γ optimum of
-    a D-scaled plant the explicit formulas' poles are fast; the K-step at a fixed level
-    takes ``_LEVEL_LED_CONTROLLER`` instead)."""
+    """The options of every K-step: the user's, or the bisection Riccati search with
+    Clarabel's γ minimisation and the controller LMI after it (:data:`_KSTEP_GAMMA_SOLVER`;
+    ``controller="sdp"``: at the γ optimum of a D-scaled plant the explicit formulas'
+    poles are fast; the K-step at a fixed level takes ``_LEVEL_LED_CONTROLLER``
+    instead)."""
     from ...synthesis import HinfsynOptions
 
     return (opts.hinfsyn_options if opts.hinfsyn_options is not None
-            else HinfsynOptions(riccati_search="bisection", controller="sdp"))
+            else HinfsynOptions(riccati_search="bisection", controller="sdp",
+                                gamma_solver=_KSTEP_GAMMA_SOLVER))
 
 
 def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base, controller: str = "sdp"):
