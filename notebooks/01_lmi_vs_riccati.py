@@ -26,11 +26,11 @@
 #   invariant zeros of $(A, B_2, C_1, D_{12})$ or $(A, B_1, C_2, D_{21})$ on the imaginary axis.
 # * **LMI** (`hinfsyn(..., method="lmi")`): minimises γ over the projected (elimination) LMIs
 #   in $X, Y$ (CVXOPT's interior-point method with a KKT solver that uses the LMIs' Lyapunov
-#   structure; Clarabel where it fails); it gives a *lower bound* `gamma_lower` valid for every controller
-#   up to the solver's accuracy and the cost of a bound on $X, Y$ that keeps the problem
-#   bounded (withheld where a certified Riccati controller beats it),
-#   then reconstructs a well-conditioned controller at a slightly relaxed γ. It needs none of
-#   the rank assumptions.
+#   structure; Clarabel where it fails); it gives a *lower bound* `gamma_lower` valid for
+#   every controller up to the solver's accuracy and the cost of a bound on $X, Y$ that
+#   keeps the problem bounded (withheld where a certified Riccati controller beats it),
+#   then reconstructs a well-conditioned controller at a slightly relaxed γ. It needs none
+#   of the rank assumptions.
 #
 # Whatever the method, `hinfsyn` reports as `gamma` the **certified** closed-loop norm
 # `hinfnorm(lft(P, K))`, computed by a Hamiltonian iteration that does not know how $K$ was

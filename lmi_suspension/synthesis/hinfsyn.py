@@ -580,7 +580,8 @@ def _explicit(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling, sol,
     ``_EXPLICIT_POLE_CAP`` allows.
 
     ``(R, S)`` of the γ step are scaled by ``c = sqrt(1 + r)``, then, where the poles
-    are beyond the cap, by ``c = (1 + r)**0.9`` (``_EXPLICIT_SCALINGS``): if they satisfy the two
+    are beyond the cap, by ``c = (1 + r)**0.9`` (``_EXPLICIT_SCALINGS``): if they
+    satisfy the two
     projected bounded-real inequalities at ``g``, ``(cR, cS)`` satisfy them at
     ``(1 + r) g`` for every ``c`` in ``[1/(1 + r), 1 + r]`` (``c`` times the old
     inequality, congruent, plus a negative semidefinite term), and the coupling gains
@@ -593,7 +594,8 @@ def _explicit(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling, sol,
     plant_fastest = float(np.max(np.abs(np.linalg.eigvals(G.A)))) if G.nstates else 0.0
     cap = _EXPLICIT_POLE_CAP * max(1.0, plant_fastest)
     t_cert = 0.0
-    for exponent in _EXPLICIT_SCALINGS if r else (0.5,):
+    # at a fixed level (r = 0) every scaling is c = 1: one attempt
+    for exponent in _EXPLICIT_SCALINGS if r else _EXPLICIT_SCALINGS[:1]:
         c = float((1.0 + r) ** exponent)
         try:
             Ks, cond_xy = _lmi.decoupled_controller(Ps, c * sol.R, c * sol.S, g_ctrl)

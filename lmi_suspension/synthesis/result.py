@@ -97,8 +97,9 @@ class HinfsynOptions:
         took 3.4 s and stopped 0.02 % above the optimum, the second 9.3 s and 0.16 %
         above it (OpenBLAS Haswell, measured 2026-11-29); under the Sandybridge,
         Nehalem and SkylakeX kernels the first stalls on that plant (60 iterations,
-        then Clarabel: 21 s in all), see ``benchmarks/HISTORY.md``.  Fixed-level problems, the controller LMI and
-        :func:`~lmi_suspension.synthesis.msyn` are always Clarabel's.
+        then Clarabel: 21 s in all), see ``benchmarks/HISTORY.md``.  Fixed-level
+        problems, the controller LMI and :func:`~lmi_suspension.synthesis.msyn` are
+        always Clarabel's.
     """
 
     gamma: float | None = None
