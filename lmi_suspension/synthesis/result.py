@@ -36,7 +36,9 @@ class HinfsynOptions:
         targets ``gamma_atol`` instead of a relative relaxation of 0.
     tol_gap_abs, tol_gap_rel, tol_feas : float
         Clarabel tolerances (passed explicitly), and CVXOPT's ``abstol``, ``reltol``,
-        ``feastol`` in the structured γ minimisation (``gamma_solver``).
+        ``feastol`` in the structured γ minimisation (``gamma_solver``), where the
+        feasibility tolerance is at least 1e-7, CVXOPT's default: its dual residual
+        has a floor near 1e-8 that depends on the BLAS kernel.
     reduced_tol_gap_abs, reduced_tol_gap_rel, reduced_tol_feas : float
         "Almost solved" tolerances (Clarabel's, and the structured γ minimisation's
         relative gap and feasibility): a solve that stalls within them is accepted as

@@ -24,6 +24,14 @@ programming problems derived from the KYP lemma" (LNCIS 312, 2005).  Right-hand 
 and the step in ``z`` are formed in the scaled space (``Ũ``, ``Ṽ``), never through
 ``W⁻¹ W⁻ᵀ``, whose condition number grows without bound near the optimum.
 
+The complement squares the condition number of the scaled constraint map ``G̃ = W⁻ᵀ G``,
+and near a degenerate optimum its Cholesky factor no longer resolves the dual equations
+``G̃ᵀ (W uz) = bx``: on one small plant in six the dual residual stops falling above
+CVXOPT's tolerance, and the run ends without a solution.  There a second run solves each
+KKT system by MINRES, preconditioned by the same factor, with ``G̃`` and ``G̃ᵀ`` applied
+apart (:meth:`_GammaProblem._minres`): as accurate as CVXOPT's own QR solve, whose cost
+grows with the square of the number of unknowns times the cone's dimension.
+
 CVXOPT is a dependency of this module alone; every other LMI of the package is posed in
 CVXPY and solved by Clarabel, and :func:`~lmi_suspension.synthesis.lmi.gamma_lmi` falls
 back to that route wherever this one does not end with an optimal solution.
@@ -37,6 +45,7 @@ from dataclasses import dataclass
 import cvxopt
 import numpy as np
 import scipy.linalg
+import scipy.sparse.linalg
 from cvxopt import misc
 
 from ..errors import SolverError
@@ -51,14 +60,36 @@ logger = logging.getLogger(__name__)
 #: before the optimum on the 4-30-state benchmark plants, with 1e-13 (and the
 #: refinement below) every one of them reached CVXOPT's tolerances (measured 2026-11-29)
 _REGULARISATION = (0.0, 1e-13, 1e-11, 1e-9, 1e-7)
-#: bound on CVXOPT's iterations, below ``max_iter`` (Clarabel's bound, 200): the runs
-#: that end optimal took 12-26 (benchmark plants n = 4-60, 12 COMPleib plants), and one that
-#: stalled (the property test's plant of seed 2374001 under OpenBLAS Sandybridge) kept
-#: the same residuals from its 20th iteration to its 95th, where CVXOPT divided by
-#: zero; Clarabel then solves the problem (measured 2026-11-29)
+#: bound on CVXOPT's iterations per run, below ``max_iter`` (Clarabel's bound, 200):
+#: the runs that ended optimal took 12-41 (benchmark plants n = 4-60, the 12 COMPleib
+#: plants and 200 random plants of 2-8 states), and a run that stalls does not
+#: recover: one kept the same residuals from its 20th iteration to its 95th, where
+#: CVXOPT divided by zero (measured 2026-11-29)
 _MAX_ITERATIONS = 60
-#: iterative-refinement steps against the unregularised complement where a
-#: regularisation was needed (each costs two applications of the constraint map)
+#: least feasibility tolerance given to CVXOPT (its own default).  Its dual residual
+#: ``||Gᵀz + c||`` is relative to ``||c|| = 1`` and has a floor of 0.9-1.4e-8 on the
+#: 40-state benchmark plant, by OpenBLAS kernel: with ``feastol=1e-8`` the kernels whose
+#: floor was above it (Sandybridge, Nehalem, SkylakeX) kept iterating at a closed gap
+#: until the primal residual grew from 1e-11 to 1e-2 (60 iterations, then Clarabel);
+#: with 1e-7 every kernel ends optimal in 23 iterations, γ within 1.6e-5 of each other
+#: (measured 2026-11-29, the sixteenth and seventeenth sessions, benchmarks/HISTORY.md)
+_FEASTOL = 1e-7
+#: MINRES's relative tolerance and iteration bound per KKT solve of the second run
+#: (``_GammaProblem._minres``); each iteration costs a triangular solve with the
+#: factor.  With these, of 212 problems (the 12 COMPleib plants and 200 random plants
+#: of 2-8 states) the Cholesky run failed on 33 under OpenBLAS SkylakeX, and the MINRES
+#: run ended optimal on 31 of them, where Clarabel's γ was up to 1.1 % higher, or
+#: lower with its LMIs violated by 5e-4 (measured 2026-11-29, benchmarks/HISTORY.md).
+#: On the 40-state benchmark plant it averaged 26 iterations a solve (10 s for the
+#: run), which is why it is the second run and not the first
+_MINRES_RTOL = 1e-12
+_MINRES_ITERATIONS = 50
+#: iterative-refinement steps against the unregularised complement, at every solve
+#: (each costs two applications of the constraint map and a triangular solve).  Near
+#: the optimum the factorisation is inaccurate even where no regularisation was
+#: needed: on the property test's plant of seed 2374001, without refinement, the dual
+#: residual jumped from 1e-9 to 2e-7 at the 19th iteration under OpenBLAS SkylakeX and
+#: the run stalled; with it every kernel ends optimal in 19 (measured 2026-11-29)
 _REFINEMENT_STEPS = 3
 
 
@@ -68,8 +99,9 @@ class StructuredSolution:
     ``Rt``, ``St`` of the projections' coordinates, CVXOPT's ``status`` ("optimal", or
     "optimal_inaccurate" for a run that stopped short of its tolerances but within the
     reduced ones, ``reduced_tol_gap_rel`` and ``reduced_tol_feas``: a γ near 0, whose
-    relative gap CVXOPT does not define, is never accepted so), its ``iterations``, and
-    how many factorisations needed a regularised Schur complement."""
+    relative gap CVXOPT does not define, is never accepted so), and the ``iterations``,
+    regularised factorisations and KKT solve of the run that is returned (the MINRES
+    run follows a Cholesky run that failed)."""
 
     gamma: float
     Rt: np.ndarray
@@ -81,6 +113,8 @@ class StructuredSolution:
     #: the dual multiplier of the trace bound: doubling the bound lowers γ by at most
     #: ``trace_multiplier * trace_bound`` (convexity)
     trace_multiplier: float
+    #: the KKT solve of the run that was returned: "Cholesky" or "MINRES"
+    kkt: str = "Cholesky"
 
 
 @dataclass(frozen=True)
@@ -182,7 +216,7 @@ class _GammaProblem:
     cone per inequality, the coupling last."""
 
     def __init__(self, inequalities: list[_Inequality], coupling: np.ndarray,
-                 trace_bound: float, margin: float):
+                 trace_bound: float, margin: float, minres: bool = False):
         n = coupling.shape[0]
         self.n = n
         self.basis = _Basis(n)
@@ -207,6 +241,9 @@ class _GammaProblem:
         I2 = np.eye(2 * n)
         self._plain = _Factors(Gl, tuple((q.U, q.V, q.Q) for q in inequalities),
                                I2[:, :n], I2[:, n:])
+        #: the KKT solve: the Cholesky factor of the Schur complement and iterative
+        #: refinement (False), or MINRES on the KKT system preconditioned by that factor
+        self.minres = minres
         self.regularised = 0
         self._level = 0
 
@@ -313,11 +350,40 @@ class _GammaProblem:
             bz = np.concatenate([vl] + [Z.ravel(order="F") for Z in Zs])
             r = np.array(x).ravel() + self._apply_T(bz, factors)
             ux = solve(r)
-            for _ in range(_REFINEMENT_STEPS if delta else 0):
-                ux = ux + solve(r - self._apply_T(self._apply(ux, factors), factors))
+            if self.minres:
+                ux, uz = self._minres(ux, np.array(x).ravel(), bz, factors, solve)
+            else:
+                for _ in range(_REFINEMENT_STEPS):
+                    ux = ux + solve(r - self._apply_T(self._apply(ux, factors), factors))
+                uz = self._apply(ux, factors) - bz
             x[:] = cvxopt.matrix(ux)
-            z[:] = cvxopt.matrix(self._apply(ux, factors) - bz)
+            z[:] = cvxopt.matrix(uz)
         return f
+
+    def _minres(self, ux, bx, bz, factors, solve):
+        """The KKT system in the scaled space, ``[[-I, G̃], [G̃ᵀ, 0]] [W uz; ux] = [W⁻ᵀ bz;
+        bx]``, by MINRES from the Cholesky solution ``ux``, preconditioned by
+        ``diag(I, M⁻¹)`` with the Schur complement's factor ``M⁻¹`` (``solve``).  With the
+        exact complement the preconditioned system has three eigenvalues (Murphy, Golub &
+        Wathen, SIAM J. Sci. Comput. 21(6), 2000) and MINRES ends in three iterations;
+        where the factor is inaccurate it goes on, working with ``G̃`` and ``G̃ᵀ`` apart,
+        never with their product, whose condition number is the square of ``G̃``'s."""
+        k, m = bz.size, ux.size
+
+        def kkt(v):
+            return np.concatenate([self._apply(v[k:], factors) - v[:k],
+                                   self._apply_T(v[:k], factors)])
+
+        def precondition(v):
+            return np.concatenate([v[:k], solve(v[k:])])
+
+        shape = (k + m, k + m)
+        A = scipy.sparse.linalg.LinearOperator(shape, matvec=kkt, dtype=float)
+        P = scipy.sparse.linalg.LinearOperator(shape, matvec=precondition, dtype=float)
+        x0 = np.concatenate([self._apply(ux, factors) - bz, ux])
+        v, _ = scipy.sparse.linalg.minres(A, np.concatenate([bz, bx]), x0=x0, M=P,
+                                          rtol=_MINRES_RTOL, maxiter=_MINRES_ITERATIONS)
+        return v[k:], v[:k]
 
 
 def minimise_gamma(projections, coupling: np.ndarray, trace_bound: float, margin: float,
@@ -337,9 +403,9 @@ def minimise_gamma(projections, coupling: np.ndarray, trace_bound: float, margin
         Strictness margin of the inequalities.
     options : HinfsynOptions
         ``tol_gap_abs``, ``tol_gap_rel``, ``tol_feas`` (CVXOPT's ``abstol``, ``reltol``,
-        ``feastol``), ``max_iter`` (at most ``_MAX_ITERATIONS``), and the reduced
-        tolerances within which a run that stops short of them is accepted as
-        "optimal_inaccurate".
+        ``feastol``, the last at least ``_FEASTOL``), ``max_iter`` (at most
+        ``_MAX_ITERATIONS``), and the reduced tolerances within which a run that stops
+        short of them is accepted as "optimal_inaccurate".
 
     Returns
     -------
@@ -367,33 +433,48 @@ def minimise_gamma(projections, coupling: np.ndarray, trace_bound: float, margin
     n = coupling.shape[0]
     settings = dict(show_progress=False, maxiters=min(int(options.max_iter), _MAX_ITERATIONS),
                     abstol=float(options.tol_gap_abs), reltol=float(options.tol_gap_rel),
-                    feastol=float(options.tol_feas), refinement=1)
-    try:
-        ineqs = [_Inequality.from_projection(p, n, of_s)
-                 for p, of_s in projections if p is not None]
-        prob = _GammaProblem(ineqs, coupling, trace_bound, margin)
-        sol = cvxopt.solvers.conelp(prob.c, prob.G, prob.h, prob.dims,
-                                    kktsolver=prob.kktsolver, options=settings)
-    except (ArithmeticError, ValueError, MemoryError) as exc:
-        # conelp raises ValueError where its first factorisation fails; the complement
-        # takes 8 n⁴ bytes (0.8 GB at 100 states), which a small machine may not have
-        raise SolverError(f"structured γ minimisation: CVXOPT failed ({exc})",
-                          status="failed") from exc
-    status = sol["status"]
-    if status != "optimal":
+                    feastol=max(float(options.tol_feas), _FEASTOL), refinement=1)
+    ineqs = [_Inequality.from_projection(p, n, of_s)
+             for p, of_s in projections if p is not None]
+    failures, close = [], None
+    for minres in (False, True):
+        kkt = "MINRES" if minres else "Cholesky"
+        try:
+            prob = _GammaProblem(ineqs, coupling, trace_bound, margin, minres)
+            sol = cvxopt.solvers.conelp(prob.c, prob.G, prob.h, prob.dims,
+                                        kktsolver=prob.kktsolver, options=settings)
+        except MemoryError as exc:
+            # the complement takes 8 n⁴ bytes (0.8 GB at 100 states), which a small
+            # machine may not have: the second solve needs it too
+            raise SolverError(f"structured γ minimisation: CVXOPT failed ({exc!r})",
+                              status="failed") from exc
+        except (ArithmeticError, ValueError) as exc:
+            # conelp raises ValueError where its first factorisation fails
+            failures.append(f"CVXOPT failed ({exc}) with the {kkt} KKT solve")
+            continue
+        status = sol["status"]
+        if status == "optimal":
+            return _solution(prob, sol, status, kkt)
         gap, pres, dres = (sol.get(k) for k in ("relative gap", "primal infeasibility",
                                                 "dual infeasibility"))
-        close = all(v is not None for v in (gap, pres, dres)) and \
-            gap <= options.reduced_tol_gap_rel and max(pres, dres) <= options.reduced_tol_feas
-        if status != "unknown" or not close:
-            raise SolverError(f"structured γ minimisation: CVXOPT status {status!r} after "
-                              f"{sol['iterations']} iterations (relative gap {gap}, "
-                              f"infeasibilities {pres}, {dres})", status=str(status))
-        status = "optimal_inaccurate"
+        if status == "unknown" and close is None and \
+                all(v is not None for v in (gap, pres, dres)) and \
+                gap <= options.reduced_tol_gap_rel and \
+                max(pres, dres) <= options.reduced_tol_feas:
+            close = prob, sol, kkt
+        failures.append(f"CVXOPT status {status!r} after {sol['iterations']} iterations "
+                        f"(relative gap {gap}, infeasibilities {pres}, {dres}) with the "
+                        f"{kkt} KKT solve")
+    if close is not None:
+        return _solution(*close[:2], "optimal_inaccurate", close[2])
+    raise SolverError("structured γ minimisation: " + "; ".join(failures), status="failed")
+
+
+def _solution(prob: _GammaProblem, sol: dict, status: str, kkt: str) -> StructuredSolution:
     x = np.array(sol["x"]).ravel()
     nv = prob.nv
-    logger.info("structured γ minimisation: %s in %d iterations (%d regularised)",
-                status, sol["iterations"], prob.regularised)
+    logger.info("structured γ minimisation: %s in %d iterations (%d regularised, %s)",
+                status, sol["iterations"], prob.regularised, kkt)
     return StructuredSolution(float(x[-1]), prob.basis.matrix(x[:nv]),
                               prob.basis.matrix(x[nv:-1]), status, int(sol["iterations"]),
-                              prob.regularised, float(sol["z"][0]))
+                              prob.regularised, float(sol["z"][0]), kkt)
