@@ -45,7 +45,8 @@ class HinfsynOptions:
         ``optimal_inaccurate`` (reported in ``warnings``); γ only needs to be accurate to
         a fraction of ``gamma_relax``.
     max_iter : int
-        Iteration bound per solve (Clarabel's and CVXOPT's).
+        Iteration bound per solve: Clarabel's, and CVXOPT's per run of the structured
+        γ minimisation (at most two runs of at most 60 iterations each).
     margin : float
         Strictness margin of the LMIs (``L <= -margin I``) in scaled data.
     xy_bound : float
@@ -97,11 +98,12 @@ class HinfsynOptions:
         Clarabel solves the same problem (``warnings`` says so).  ``"clarabel"`` poses it
         in CVXPY for Clarabel.  On the 40-state plant of ``bench_hinfsyn.py`` the first
         took 3.4 s and stopped 0.02 % above the optimum, the second 9.3 s and 0.16 %
-        above it (OpenBLAS Haswell, measured 2026-11-29); under the Sandybridge,
-        Nehalem and SkylakeX kernels the first stalls on that plant (60 iterations,
-        then Clarabel: 21 s in all), see ``benchmarks/HISTORY.md``.  Fixed-level
-        problems, the controller LMI and :func:`~lmi_suspension.synthesis.msyn` are
-        always Clarabel's.
+        above it (OpenBLAS Haswell, measured 2026-11-29); under Sandybridge, Nehalem
+        and SkylakeX the first ends optimal too, in 3.3-4.9 s (``benchmarks/HISTORY.md``).
+        Where its Cholesky solves of the KKT systems lose the dual equations near the
+        optimum (one small plant in six), a second run solves them by MINRES before
+        Clarabel is asked.  Fixed-level problems, the controller LMI and
+        :func:`~lmi_suspension.synthesis.msyn` are always Clarabel's.
     """
 
     gamma: float | None = None

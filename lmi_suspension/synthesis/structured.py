@@ -75,8 +75,8 @@ _MAX_ITERATIONS = 60
 #: (measured 2026-11-29, the sixteenth and seventeenth sessions, benchmarks/HISTORY.md)
 _FEASTOL = 1e-7
 #: MINRES's relative tolerance and iteration bound per KKT solve of the second run
-#: (``_GammaProblem._minres``); each iteration costs a triangular solve with the
-#: factor.  With these, of 212 problems (the 12 COMPleib plants and 200 random plants
+#: (``_GammaProblem._minres``); each iteration costs two triangular solves with the
+#: factor and an application of ``G̃`` and of ``G̃ᵀ``.  With these, of 212 problems (the 12 COMPleib plants and 200 random plants
 #: of 2-8 states) the Cholesky run failed on 33 under OpenBLAS SkylakeX, and the MINRES
 #: run ended optimal on 31 of them, where Clarabel's γ was up to 1.1 % higher, or
 #: lower with its LMIs violated by 5e-4 (measured 2026-11-29, benchmarks/HISTORY.md).
@@ -85,7 +85,7 @@ _FEASTOL = 1e-7
 _MINRES_RTOL = 1e-12
 _MINRES_ITERATIONS = 50
 #: iterative-refinement steps against the unregularised complement, at every solve
-#: (each costs two applications of the constraint map and a triangular solve).  Near
+#: (each costs an application of ``G̃`` and of ``G̃ᵀ`` and two triangular solves).  Near
 #: the optimum the factorisation is inaccurate even where no regularisation was
 #: needed: on the property test's plant of seed 2374001, without refinement, the dual
 #: residual jumped from 1e-9 to 2e-7 at the 19th iteration under OpenBLAS SkylakeX and
@@ -244,6 +244,8 @@ class _GammaProblem:
         #: the KKT solve: the Cholesky factor of the Schur complement and iterative
         #: refinement (False), or MINRES on the KKT system preconditioned by that factor
         self.minres = minres
+        #: MINRES solves that ended at their iteration bound (their step is used)
+        self.unconverged = 0
         self.regularised = 0
         self._level = 0
 
@@ -381,8 +383,11 @@ class _GammaProblem:
         A = scipy.sparse.linalg.LinearOperator(shape, matvec=kkt, dtype=float)
         P = scipy.sparse.linalg.LinearOperator(shape, matvec=precondition, dtype=float)
         x0 = np.concatenate([self._apply(ux, factors) - bz, ux])
-        v, _ = scipy.sparse.linalg.minres(A, np.concatenate([bz, bx]), x0=x0, M=P,
-                                          rtol=_MINRES_RTOL, maxiter=_MINRES_ITERATIONS)
+        v, info = scipy.sparse.linalg.minres(A, np.concatenate([bz, bx]), x0=x0, M=P,
+                                             rtol=_MINRES_RTOL, maxiter=_MINRES_ITERATIONS)
+        if info < 0:
+            raise ArithmeticError(f"MINRES broke down (info {info})")
+        self.unconverged += info > 0
         return v[k:], v[:k]
 
 
@@ -434,8 +439,11 @@ def minimise_gamma(projections, coupling: np.ndarray, trace_bound: float, margin
     settings = dict(show_progress=False, maxiters=min(int(options.max_iter), _MAX_ITERATIONS),
                     abstol=float(options.tol_gap_abs), reltol=float(options.tol_gap_rel),
                     feastol=max(float(options.tol_feas), _FEASTOL), refinement=1)
-    ineqs = [_Inequality.from_projection(p, n, of_s)
-             for p, of_s in projections if p is not None]
+    try:
+        ineqs = [_Inequality.from_projection(p, n, of_s)
+                 for p, of_s in projections if p is not None]
+    except ValueError as exc:
+        raise SolverError(f"structured γ minimisation: {exc}", status="failed") from exc
     failures, close = [], None
     for minres in (False, True):
         kkt = "MINRES" if minres else "Cholesky"
@@ -445,36 +453,41 @@ def minimise_gamma(projections, coupling: np.ndarray, trace_bound: float, margin
                                         kktsolver=prob.kktsolver, options=settings)
         except MemoryError as exc:
             # the complement takes 8 n⁴ bytes (0.8 GB at 100 states), which a small
-            # machine may not have: the second solve needs it too
-            raise SolverError(f"structured γ minimisation: CVXOPT failed ({exc!r})",
-                              status="failed") from exc
+            # machine may not have; the second run would need as much
+            failures.append(f"out of memory ({exc!r}) in the {kkt} run")
+            break
         except (ArithmeticError, ValueError) as exc:
-            # conelp raises ValueError where its first factorisation fails
-            failures.append(f"CVXOPT failed ({exc}) with the {kkt} KKT solve")
+            # conelp raises ValueError where its first factorisation fails, and scipy's
+            # MINRES where the preconditioner is not definite
+            failures.append(f"failed ({exc}) in the {kkt} run")
             continue
         status = sol["status"]
         if status == "optimal":
-            return _solution(prob, sol, status, kkt)
+            return _solution(prob, sol, status, kkt, failures)
         gap, pres, dres = (sol.get(k) for k in ("relative gap", "primal infeasibility",
                                                 "dual infeasibility"))
-        if status == "unknown" and close is None and \
-                all(v is not None for v in (gap, pres, dres)) and \
+        if status == "unknown" and all(v is not None for v in (gap, pres, dres)) and \
                 gap <= options.reduced_tol_gap_rel and \
-                max(pres, dres) <= options.reduced_tol_feas:
-            close = prob, sol, kkt
+                max(pres, dres) <= options.reduced_tol_feas and \
+                (close is None or max(pres, dres) < close[3]):
+            close = prob, sol, kkt, max(pres, dres)
         failures.append(f"CVXOPT status {status!r} after {sol['iterations']} iterations "
-                        f"(relative gap {gap}, infeasibilities {pres}, {dres}) with the "
-                        f"{kkt} KKT solve")
+                        f"(relative gap {gap}, infeasibilities {pres}, {dres}) in the "
+                        f"{kkt} run")
     if close is not None:
-        return _solution(*close[:2], "optimal_inaccurate", close[2])
+        return _solution(close[0], close[1], "optimal_inaccurate", close[2], failures)
     raise SolverError("structured γ minimisation: " + "; ".join(failures), status="failed")
 
 
-def _solution(prob: _GammaProblem, sol: dict, status: str, kkt: str) -> StructuredSolution:
+def _solution(prob: _GammaProblem, sol: dict, status: str, kkt: str,
+              failures: list[str]) -> StructuredSolution:
     x = np.array(sol["x"]).ravel()
     nv = prob.nv
-    logger.info("structured γ minimisation: %s in %d iterations (%d regularised, %s)",
-                status, sol["iterations"], prob.regularised, kkt)
+    if failures:
+        logger.info("structured γ minimisation: %s", "; ".join(failures))
+    logger.info("structured γ minimisation: %s in %d iterations (%d regularised, %s KKT "
+                "solve, %d MINRES solves at their iteration bound)", status,
+                sol["iterations"], prob.regularised, kkt, prob.unconverged)
     return StructuredSolution(float(x[-1]), prob.basis.matrix(x[:nv]),
                               prob.basis.matrix(x[nv:-1]), status, int(sol["iterations"]),
                               prob.regularised, float(sol["z"][0]), kkt)
