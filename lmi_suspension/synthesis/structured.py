@@ -171,7 +171,7 @@ class _Basis:
         self.weight = np.where(self.a == self.b, 0.5, 1.0)
         self.diagonal = np.flatnonzero(self.a == self.b)
         self._ww = self.weight[:, None] * self.weight[None, :]
-        self._buffers = None
+        self._ab, self._ba = self.a * n + self.b, self.b * n + self.a  # (r, s) of E_j
 
     def matrix(self, x: np.ndarray) -> np.ndarray:
         """``sum_i x_i E_i``."""
@@ -184,30 +184,22 @@ class _Basis:
         """``tr(E_i Z)`` for every ``i``."""
         return self.weight * (Z[self.b, self.a] + Z[self.a, self.b])
 
-    def add_pair(self, out: np.ndarray, P: np.ndarray, Q: np.ndarray, coef: float = 1.0):
-        """``out[i, j] += coef tr(E_i P E_j Q)`` for every ``i, j``: with ``E_i`` written
-        as a sum of ``e_p e_qᵀ``, each term is ``P[q, r] Q[s, p]``, gathered row-wise
-        into preallocated buffers (4 ms at 40 states, against 16 ms for flat gathers
-        with temporaries; measured 2026-11-29)."""
-        a, b = self.a, self.b
-        Qt = Q.T
-        Pa, Pb, Qa, Qb = P[a], P[b], Qt[a], Qt[b]  # (size, n): rows p or q of each i
-        T, U, V = self._scratch()
-        np.take(Pb, a, axis=1, out=T)
-        T *= np.take(Qa, b, axis=1, out=U)
-        for Pq, r, Qp, s in ((Pb, b, Qa, a), (Pa, a, Qb, b), (Pa, b, Qb, a)):
-            np.take(Pq, r, axis=1, out=U)
-            U *= np.take(Qp, s, axis=1, out=V)
-            T += U
-        T *= self._ww
-        if coef != 1.0:
-            T *= coef
-        out += T
-
-    def _scratch(self):
-        if self._buffers is None:
-            self._buffers = tuple(np.empty((self.size, self.size)) for _ in range(3))
-        return self._buffers
+    def add_pairs(self, out: np.ndarray, pairs):
+        """``out[i, j] += sum_k c_k tr(E_i P_k E_j Q_k)`` for every ``i, j``, over
+        ``pairs`` of ``(P_k, Q_k, c_k)``.  With ``E_i`` written as a sum of ``e_p e_qᵀ``,
+        a term is ``P[q, r] Q[s, p]``: the terms of each row ``i`` are summed over its
+        ``(p, q)`` and over the pairs first, as outer products of rows of ``P_k`` and
+        ``Q_kᵀ``, and the columns ``(r, s)`` of each ``E_j`` gathered once (2.5 ms for
+        three pairs at 30 states, against 5.2 ms pair by pair with gathers of every
+        term; measured 2026-11-29)."""
+        a, b, n = self.a, self.b, self.n
+        rows = np.zeros((self.size, n, n))  # rows[i, r, s]: the terms of E_i, any E_j
+        for P, Q, c in pairs:
+            Qt = Q.T
+            rows += (c * P[b])[:, :, None] * Qt[a][:, None, :]
+            rows += (c * P[a])[:, :, None] * Qt[b][:, None, :]
+        rows = rows.reshape(self.size, n * n)
+        out += (rows[:, self._ab] + rows[:, self._ba]) * self._ww
 
 
 class _GammaProblem:
@@ -302,19 +294,19 @@ class _GammaProblem:
                            for q, r in zip(self.ineqs, rti)),
                      rti[-1].T[:, :n], rti[-1].T[:, n:])
         M = f.Gl.T @ f.Gl
+        Prr, Pss, Prs = f.Ur.T @ f.Ur, f.Us.T @ f.Us, f.Ur.T @ f.Us
+        pairs = {False: [(Prr, Prr, 1.0)], True: [(Pss, Pss, 1.0)]}  # the coupling's
         for q, (U, V, Qs) in zip(self.ineqs, f.blocks):
             sl = self._slices(q.of_s)
             B = V.T @ U
-            basis.add_pair(M[sl, sl], B, B, 2.0)
-            basis.add_pair(M[sl, sl], V.T @ V, U.T @ U, 2.0)
+            pairs[q.of_s] += [(B, B, 2.0), (V.T @ V, U.T @ U, 2.0)]
             col = -2.0 * basis.trace(V.T @ Qs @ U)
             M[sl, -1] += col
             M[-1, sl] += col
             M[-1, -1] += np.sum(Qs * Qs)
-        Prr, Pss, Prs = f.Ur.T @ f.Ur, f.Us.T @ f.Us, f.Ur.T @ f.Us
-        basis.add_pair(M[:nv, :nv], Prr, Prr)
-        basis.add_pair(M[nv:-1, nv:-1], Pss, Pss)
-        basis.add_pair(M[:nv, nv:-1], Prs, Prs.T)
+        basis.add_pairs(M[:nv, :nv], pairs[False])
+        basis.add_pairs(M[nv:-1, nv:-1], pairs[True])
+        basis.add_pairs(M[:nv, nv:-1], [(Prs, Prs.T, 1.0)])
         M[nv:-1, :nv] = M[:nv, nv:-1].T
         return M, f
 
