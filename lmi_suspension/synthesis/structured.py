@@ -26,11 +26,14 @@ and the step in ``z`` are formed in the scaled space (``Ũ``, ``Ṽ``), never th
 
 The complement squares the condition number of the scaled constraint map ``G̃ = W⁻ᵀ G``,
 and near a degenerate optimum its Cholesky factor no longer resolves the dual equations
-``G̃ᵀ (W uz) = bx``: on one small plant in six the dual residual stops falling above
-CVXOPT's tolerance, and the run ends without a solution.  There a second run solves each
-KKT system by MINRES, preconditioned by the same factor, with ``G̃`` and ``G̃ᵀ`` applied
-apart (:meth:`_GammaProblem._minres`): as accurate as CVXOPT's own QR solve, whose cost
-grows with the square of the number of unknowns times the cone's dimension.
+``G̃ᵀ (W uz) = bx``: on one small plant in six (33-34 of 212 test problems under three
+OpenBLAS kernels) the dual residual stops falling above CVXOPT's tolerance, and the run
+ends without a solution.  There a second run solves each KKT system by MINRES,
+preconditioned by the same factor, with ``G̃`` and ``G̃ᵀ`` applied apart
+(:meth:`_GammaProblem._minres`).  It reached the optimum of CVXOPT's own QR solve to
+3e-10 where that was tried (``tests/test_structured.py``); the QR solve does not square
+the condition number, but its cost grows with the square of the number of unknowns
+times the cone's dimension.
 
 CVXOPT is a dependency of this module alone; every other LMI of the package is posed in
 CVXPY and solved by Clarabel, and :func:`~lmi_suspension.synthesis.lmi.gamma_lmi` falls
@@ -76,12 +79,13 @@ _MAX_ITERATIONS = 60
 _FEASTOL = 1e-7
 #: MINRES's relative tolerance and iteration bound per KKT solve of the second run
 #: (``_GammaProblem._minres``); each iteration costs two triangular solves with the
-#: factor and an application of ``G̃`` and of ``G̃ᵀ``.  With these, of 212 problems (the 12 COMPleib plants and 200 random plants
-#: of 2-8 states) the Cholesky run failed on 33 under OpenBLAS SkylakeX, and the MINRES
-#: run ended optimal on 31 of them, where Clarabel's γ was up to 1.1 % higher, or
-#: lower with its LMIs violated by 5e-4 (measured 2026-11-29, benchmarks/HISTORY.md).
-#: On the 40-state benchmark plant it averaged 26 iterations a solve (10 s for the
-#: run), which is why it is the second run and not the first
+#: factor and an application of ``G̃`` and of ``G̃ᵀ``.  With these, of 212 problems
+#: (the 12 COMPleib plants and 200 random plants of 2-8 states) the Cholesky run failed
+#: on 33 under OpenBLAS SkylakeX, and the MINRES run ended optimal on 31 of them (28-31
+#: of 31-34 under Haswell, Sandybridge, Nehalem), where Clarabel's γ was up to 1.1 %
+#: higher, or lower with its LMIs violated by up to 1e-2 (measured 2026-11-29,
+#: benchmarks/HISTORY.md).  On the 40-state benchmark plant it averaged 26 iterations
+#: a solve (10 s for the run), which is why it is the second run and not the first
 _MINRES_RTOL = 1e-12
 _MINRES_ITERATIONS = 50
 #: iterative-refinement steps against the unregularised complement, at every solve
