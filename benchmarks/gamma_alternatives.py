@@ -3,8 +3,9 @@
 Run: ``python benchmarks/gamma_alternatives.py [N [PART ...]]`` with N the order of
 ``bench_hinfsyn.plant`` (22 by default) and PART among ``accuracy``, ``solvers``,
 ``early``, ``controller``, ``cuts``, ``structured`` (the first five by default).  Each
-part poses what ``hinfsyn(method="lmi")`` poses on the scaled plant and prints seconds, interior-point iterations and, where a controller is
-formed, its certified γ (``hinfnorm(lft(P, K))``) and fastest pole:
+part poses what ``hinfsyn(method="lmi")`` poses on the scaled plant and prints seconds,
+interior-point iterations and, where a controller is formed, its certified γ
+(``hinfnorm(lft(P, K))``) and fastest pole:
 
 ``accuracy``
     The first γ minimisation (identity frame), one round in the frame of its solution,

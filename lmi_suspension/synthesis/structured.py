@@ -93,7 +93,12 @@ _MINRES_ITERATIONS = 50
 #: the optimum the factorisation is inaccurate even where no regularisation was
 #: needed: on the property test's plant of seed 2374001, without refinement, the dual
 #: residual jumped from 1e-9 to 2e-7 at the 19th iteration under OpenBLAS SkylakeX and
-#: the run stalled; with it every kernel ends optimal in 19 (measured 2026-11-29)
+#: the run stalled; with it every kernel ends optimal in 19 (measured 2026-11-29).
+#: Since the complement is assembled by ``_Basis.add_pairs`` that plant ends optimal
+#: either way, and on the 212 problems of benchmarks/HISTORY.md the unregularised
+#: refinement saves 1-3 MINRES runs (33 against 34-36, SkylakeX and Haswell) for about
+#: a fifth of the structured route's time on those small plants; on the benchmark
+#: plants (30, 40 states) its cost is within the noise
 _REFINEMENT_STEPS = 3
 
 

@@ -72,8 +72,9 @@ _LEVEL_LED_RECOVERIES = 1
 #: 2026-11-28, benchmarks/HISTORY.md)
 _LEVEL_LED_CONTROLLER = "explicit"
 #: the solver of the first LMI K-step's γ minimisation under the default K-step options.
-#: With the structured solver (``hinfsyn``'s default since 2026-11-29) default ``musyn``
-#: on distillation ended at µ 0.959009-0.960169 over the 8 OpenBLAS kernel and thread
+#: With the structured solver (``hinfsyn``'s default since 2026-11-29; measured before
+#: its feasibility tolerance, refinement and MINRES run of the next session) default
+#: ``musyn`` on distillation ended at µ 0.959009-0.960169 over the 8 OpenBLAS kernel and thread
 #: rows (above the 0.9600 target on one, a spread of 1.2e-3), with Clarabel's at
 #: 0.959417-0.959536 (stop 54); the K-steps were 0.7 s of its 11-14 s either way
 #: (measured 2026-11-29, ``../shared/tools/kernels python benchmarks/musyn_default.py``)
