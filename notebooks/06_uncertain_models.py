@@ -200,11 +200,13 @@ table(rows)
 
 # %% [markdown]
 # µ above 1 with the performance block allows instability inside the range, and robust
-# performance was reached by neither design with these weights. What keeping the
-# parameter real bought shows here (measured 2026-11-27): the complex design is
-# destabilised by a stiffness inside $[0.5, 2]$ (k ≈ 0.531), the mixed one only outside
-# it (k ≈ 0.494), with its worst gain at the soft end of the range. The nominal closed
-# loops, for reference:
+# performance was reached by neither design with these weights. Both designs lose
+# stability near the soft end of the range (k ≈ 0.53 for the complex design). Whether the
+# mixed design's destabilising stiffness lies just inside or just outside $[0.5, 2]$
+# depends on the OpenBLAS kernel its D-G-K iteration ran under (2026-12-02: k ≈ 0.496 under
+# Haswell, 0.537 under Sandybridge): the guarantee that holds on every machine is the one
+# asserted above, the mixed design's certified µ below the complex design's µ lower bound.
+# The nominal closed loops, for reference:
 
 # %%
 for label, res in designs.items():

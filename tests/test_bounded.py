@@ -71,6 +71,7 @@ def test_the_linear_closed_loop_keeps_the_limits_on_the_bump_without_clipping(bo
     assert np.max(np.abs(sim.u_command)) <= bounded.u_peak * (1 + 1e-3)
 
 
+@pytest.mark.slow  # 16 s on Zen 1 (2026-12-02): the second tier
 def test_the_force_bound_is_active_and_costs_comfort_monotonically():
     free = design_peak_bounded(np.inf, np.inf)
     # the unconstrained design is hinfsyn's problem on the objective channel

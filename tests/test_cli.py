@@ -138,6 +138,7 @@ def test_simulate_discrete_runs_the_sampled_data_loop(capsys, tmp_path):
                                                    rel=1e-12)
 
 
+@pytest.mark.slow  # 16 s on Zen 1 (2026-12-02): the second tier
 def test_design_runs_any_route_and_prints_its_certificate(capsys, tmp_path):
     """``design ROUTE``: the file reads back as the route's design; the certificate's
     first row is the time simulation at 0 ms, recomputed here."""
@@ -160,6 +161,7 @@ def test_design_runs_any_route_and_prints_its_certificate(capsys, tmp_path):
     assert tuple(route.choices) == ROUTE_NAMES
 
 
+@pytest.mark.slow  # 22 s on Zen 1 (2026-12-02): the second tier
 def test_refine_writes_a_controller_and_its_certificate(capsys, tmp_path):
     """``refine`` with one SLSQP iteration: far from the requirements (exit status 1),
     but the file is written with both realizations and the certificate's table printed;
@@ -179,6 +181,7 @@ def test_refine_writes_a_controller_and_its_certificate(capsys, tmp_path):
     assert "µ upper" in text
 
 
+@pytest.mark.slow  # 105 s on Zen 1 (2026-12-02): the second tier
 def test_occupants_certifies_and_draws_each_controller(capsys, tmp_path):
     """``occupants`` on the shipped refined controller and a second copy of it, with a
     few samples: one table row and one map per controller, the JSON holds what the

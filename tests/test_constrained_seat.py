@@ -71,6 +71,7 @@ def test_shipped_controller_on_the_bump(shipped, delay):
     assert sampled.saturated_fraction == 0.0
 
 
+@pytest.mark.slow  # 95 s on Zen 1 (2026-12-02): the second tier
 def test_design_without_the_disk_meets_its_bounds():
     """One K-step without the pole disk (about 10 s): every figure recomputed by
     certify_constrained, which shares no code with the synthesis's own certificates."""
@@ -90,6 +91,7 @@ def test_bad_bounds_are_typed_errors(kwargs):
         design_constrained_mu(**kwargs)
 
 
+@pytest.mark.slow  # 26 s on Zen 1 (2026-12-02): the second tier
 def test_bounds_no_controller_meets_are_infeasible():
     # 1 N of force cannot hold the stroke below 1 cm (the passive seat's worst case for
     # the bump's energy is 6.4 cm)
@@ -150,6 +152,7 @@ def test_tradeoff_bad_bounds_are_typed_errors(bounds):
         constrained_tradeoff(bounds)
 
 
+@pytest.mark.slow  # 25 s on Zen 1 (2026-12-02): the second tier
 def test_tradeoff_cli_writes_table_figure_and_controllers(stand_in_designs, tmp_path,
                                                           monkeypatch, capsys):
     import json

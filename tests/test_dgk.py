@@ -126,6 +126,7 @@ def test_optimal_gscales_reach_the_pointwise_mixed_bound_and_certify_on_the_grid
     assert max(sig) <= 1 + 1e-5
 
 
+@pytest.mark.slow  # 25 s on Zen 1 (2026-12-02): the second tier
 def test_musyn_with_real_blocks_kept_real_returns_certified_bounds():
     """complexify=False (D-G-K, the default): whatever its path, the returned controller
     stabilises the loop, its µ bounds use the real structure (lower <= upper on the
@@ -146,12 +147,19 @@ def test_musyn_with_real_blocks_kept_real_returns_certified_bounds():
 uncertain_oscillator = uncertain_stiffness_oscillator
 
 
+@pytest.mark.slow  # 26 s on Zen 1 (2026-12-02): the second tier
 def test_musyn_takes_an_uncertain_plant_and_its_bound_holds_on_the_scaled_range():
     """musyn(uss, nmeas, ncon): the structure is lftdata's plus the performance block,
     and the returned all-frequency bound β = mu_bound means (main loop theorem) that for
     every stiffness in the range shrunk by 1/β the loop is stable with ‖e/d‖∞ ≤ β:
     checked by brute force on 21 stiffness values, each loop built by usubs and its
-    norm computed directly (a route that shares nothing with the µ bounds)."""
+    norm computed directly (a route that shares nothing with the µ bounds).
+
+    The same norms bound β from above: a real |δ| <= 1/β whose loop has norm ν gives
+    µ >= min(β, ν) (a complex performance block of size 1/ν closing that loop makes
+    I - MΔ singular, and σ̄(Δ) = max(|δ|, 1/ν)), so β cannot exceed the largest ν by
+    more than the interval certificate's slack (0.1 %, ``_SUP_RTOL``) plus the
+    shortfall of the sampled δ: an inflated mu_bound fails."""
     Pu = uncertain_oscillator()
     res = musyn(Pu, 1, 1, omega=np.logspace(-2, 1.5, 25),
                 options=MusynOptions(max_iter=2, method="riccati", complexify=False,
@@ -159,10 +167,17 @@ def test_musyn_takes_an_uncertain_plant_and_its_bound_holds_on_the_scaled_range(
     assert res.mu.blk.to_blk().tolist() == [[-1, 0], [2, 2]]
     beta = res.mu_bound
     assert res.mu_peak <= beta and np.isfinite(beta)
+    norms = []
     for delta in np.linspace(-1, 1, 21) / beta:
         loop = lft(usubs(Pu, {"k": 1.0 + 0.5 * delta}), res.K, 1, 1)
         assert np.all(loop.poles().real < 0)
-        assert float(hinfnorm(loop)[0]) <= beta * (1 + 1e-6)
+        norms.append(float(hinfnorm(loop)[0]))
+    assert max(norms) <= beta * (1 + 1e-6)
+    # β / max ν measured 1.0012 under the Haswell kernel (β 1.14674, ν 1.14537 at
+    # δ = -1/β; mussv's upper and lower bounds meet at 1.14559 on a 301-point grid) and
+    # under Sandybridge (another design: β 1.12986, ν 1.12853), 2026-12-01; 2e-3
+    # allows the certificate's documented 1e-3 and the δ sampling
+    assert beta <= max(norms) * (1 + 2e-3)
 
 
 def test_musyn_blk_goes_with_certain_plants_only():
@@ -190,6 +205,7 @@ def test_the_ureal_model_is_the_hand_built_lft():
                                    atol=1e-12)
 
 
+@pytest.mark.slow  # 56 s on Zen 1 (2026-12-02): the second tier
 def test_constraints_ride_in_the_dgk_k_step():
     """Issue 37, item 3: with a real block kept real, constraints still ride in the LMI
     K-step.  The plant of tests/test_musyn_constraints.py (G = 2/(s+1), 40 % input
@@ -216,8 +232,167 @@ def test_constraints_ride_in_the_dgk_k_step():
     Wc = scipy.linalg.solve_continuous_lyapunov(A, -B @ B.T)
     assert float(np.sqrt(C @ Wc @ C.T)[0, 0]) <= 0.30 * (1 + 1e-4)
     w = np.logspace(-3, 3, 121)
-    M = freqresp(control.ss(CL.A, np.asarray(CL.B)[:, :2], np.asarray(CL.C)[:2],
-                            np.asarray(CL.D)[:2, :2]), w)
-    mu = mussv(M, blk, omega=w)
+    Mss = control.ss(CL.A, np.asarray(CL.B)[:, :2], np.asarray(CL.C)[:2],
+                     np.asarray(CL.D)[:2, :2])
+    mu = mussv(freqresp(Mss, w), blk, omega=w)
     assert np.max(mu.lower) <= np.max(mu.upper) <= res.mu_bound * (1 + 1e-3)
     assert res.mu_lower_peak <= res.mu_peak * (1 + 1e-6) <= res.mu_bound * (1 + 1e-6)
+    # mu_bound from above, by the main loop theorem (no µ code): each real |δ| <= 1/β
+    # closed on the real block leaves a stable loop of norm ν <= β, and µ >= min(β, ν)
+    # (a complex performance block of size 1/ν makes I - MΔ singular), so β may exceed
+    # the largest ν only by the certificate's slack
+    beta = res.mu_bound
+    Mp = control.ss(Mss.A, np.asarray(Mss.B)[:, [1, 0]], np.asarray(Mss.C)[[1, 0]],
+                    np.asarray(Mss.D)[np.ix_([1, 0], [1, 0])])  # the real channel last
+    norms = []
+    for delta in np.linspace(-1, 1, 21) / beta:
+        closed = lft(Mp, control.ss([], [], [], [[delta]]), 1, 1)
+        assert np.max(np.linalg.eigvals(np.asarray(closed.A)).real) < 0
+        norms.append(float(hinfnorm(closed)[0]))
+    assert max(norms) <= beta * (1 + 1e-6)
+    # β / max ν measured 1.0060 (β 0.50301, ν 0.5 at δ = -1/β, where mussv's bounds
+    # meet at 0.5000 as ω -> ∞: the certificate's 20 splits stop 0.6 % above it;
+    # 2026-12-01, Haswell and Sandybridge kernels): 1 % allowed
+    assert beta <= max(norms) * (1 + 1e-2)
+
+
+# ---------------------------------------------------------------- mutation pass (issue 59)
+@pytest.mark.parametrize("poles", [[0.0, 1.0], [-1.0, 2.0], []])
+def test_gscale_basis_poles_must_have_positive_real_parts(poles):
+    """gfit's module docstring: the basis poles ``c_k`` have ``Re c_k > 0``.  A pole at 0
+    makes the basis ``ω/(c² + ω²) = 1/ω`` and the all-pass ``(c - s)/(c + s) = -1``, so
+    ``H`` and ``T`` would have a pole at s = 0: refused like a negative one, and an empty
+    basis too."""
+    from lmi_suspension.errors import DimensionError
+
+    w = np.logspace(-1, 1, 11)
+    with pytest.raises(DimensionError, match="positive real parts"):
+        fit_gscales(w, [0.1 * w / (1 + w**2)], BlockStructure.from_blk([[-1, 0]]), 1.0,
+                    poles=poles)
+
+
+def _pair(zeta, wn):
+    return control.tf([wn**2], [1, 2 * zeta * wn, wn**2])
+
+
+def test_resonances_are_the_lightly_damped_poles_and_their_half_power_edges():
+    """dgstep.resonances (its docstring): per pole pair of damping ζ < 0.3 inside the
+    grid's range, |p|, |p| (1 ± ζ) and |Im p|; nothing for a well-damped pair (ζ 0.5), a
+    real pole, or a pair beyond the grid (1e4 rad/s).  Reference: the poles placed here,
+    ζ = 0.05 at 2 rad/s: 2, 1.9, 2.1 and 2 sqrt(1 - ζ²)."""
+    from lmi_suspension.mu.steps.dgstep import resonances
+
+    CL = control.ss(_pair(0.05, 2.0) + _pair(0.5, 5.0) + _pair(0.05, 1e4)
+                    + control.tf([1.0], [1.0, 3.0]))
+    expect = np.sort([2.0, 2.0 * 0.95, 2.0 * 1.05, 2.0 * np.sqrt(1 - 0.05**2)])
+    np.testing.assert_allclose(resonances(CL, np.logspace(-1, 2, 50)), expect, rtol=1e-9)
+
+
+def test_the_dg_step_takes_mu_at_resonances_between_the_grid_points():
+    """MussvStep with constraints also takes µ at the loop's resonances, and the peak is
+    the larger.  A 1x1 complex full block, whose µ is |M| by definition (reference: the
+    loop's response evaluated here), and a pair of ζ = 0.01 at 1.05 rad/s between the
+    grid points 1 and 2: without constraints the grid's peak |M(j1)| = 10.5, with them
+    the resonance's, 50.0, at its frequency; the lower bound goes with it."""
+    from lmi_suspension.mu.steps import DKSetup
+    from lmi_suspension.mu.steps.dgstep import MussvStep, resonances
+
+    CL = control.ss(_pair(0.01, 1.05))
+    omega = np.array([0.5, 1.0, 2.0])
+    struct = BlockStructure.coerce([[1, 1]])
+
+    def step(constraints):
+        setup = DKSetup(G=None, struct=struct, dk_struct=struct, mixed=False, free=(0, 0),
+                        omega=omega, options=None, rng=np.random.default_rng(0),
+                        constraints=constraints)
+        return MussvStep(setup)(CL, None)
+
+    def gain(w):
+        return abs(complex(CL(1j * w)))
+
+    plain = step(())
+    assert plain.mu_peak == pytest.approx(max(gain(w) for w in omega), rel=1e-6)
+    at = resonances(CL, omega)
+    k = int(np.argmax([gain(w) for w in at]))
+    assert gain(at[k]) > 4 * plain.mu_peak
+    found = step(("a constraint",))
+    assert found.mu_peak == pytest.approx(gain(at[k]), rel=1e-6)
+    assert found.peak_omega == at[k]
+    assert found.lower_peak == pytest.approx(gain(at[k]), rel=1e-6)
+
+
+def test_the_best_route_replaces_an_earlier_controller_only_beyond_the_slack():
+    """_k_step with method="best": a later route replaces an earlier one only when it
+    certifies lower by more than ``_KSTEP_RTOL`` (its comment: the LMI would otherwise win
+    ties).  Injected syntheses: the plant as given certifies 1.0, the diagonally
+    balanced one 0.05 % or 0.2 % lower; both beat the previous controller's 10, so the
+    Gramian-balanced realization and the LMI are not tried."""
+    from types import SimpleNamespace
+
+    from lmi_suspension.mu.steps.kstep import _KSTEP_RTOL, _k_step
+
+    PD = control.ss([[-1.0]], [[1.0, 1.0]], [[1.0], [1.0]], np.zeros((2, 2)))
+
+    def run(second):
+        calls = []
+
+        def synthesis(P, nmeas, ncon, *, method, options, **heuristics):
+            calls.append((method, options.riccati_scale))
+            return SimpleNamespace(gamma=second if options.riccati_scale else 1.0)
+
+        best = _k_step(synthesis, PD, 1, 1, MusynOptions(method="best"), gamma_prev=10.0)
+        return best.gamma, calls
+
+    gamma, calls = run(1 - 0.5 * _KSTEP_RTOL)
+    assert gamma == 1.0 and calls == [("riccati", False), ("riccati", True)]
+    assert run(1 - 2 * _KSTEP_RTOL)[0] == 1 - 2 * _KSTEP_RTOL
+
+
+def test_an_initial_controller_that_leaves_a_marginal_pole_is_refused():
+    """``K0`` must stabilise the loop: x' = u + w, y = z = x with K0 = 0 leaves the pole
+    at s = 0 (marginal, not stable) and is refused; K0 = -1 gives 1/(s + 1), whose norm
+    1 (at ω = 0) is the certified γ."""
+    from lmi_suspension.lti.plant import GeneralizedPlant
+    from lmi_suspension.mu.steps.kstep import initial_controller
+
+    G = GeneralizedPlant.from_statespace(
+        control.ss([[0.0]], [[1.0, 1.0]], [[1.0], [1.0]], np.zeros((2, 2))), 1, 1)
+    struct = BlockStructure.coerce([[1, 1]])
+    with pytest.raises(ParameterError, match="does not stabilise"):
+        initial_controller(control.ss([], [], [], [[0.0]]), G, struct, ())
+    given = initial_controller(control.ss([], [], [], [[-1.0]]), G, struct, ())
+    assert given.gamma == pytest.approx(1.0, rel=1e-6)
+
+
+def test_overrelaxed_extrapolates_the_d_steps_change_geometrically():
+    """fit._overrelaxed: ``previous (d / previous)^α`` per block (_OverRelaxation's
+    docstring): previous 2, D-step 4 and α = 1.5 give 2 · 2^1.5; an unchanged entry stays;
+    α = 1 gives the D-step itself."""
+    from lmi_suspension.mu.steps.fit import _overrelaxed
+
+    out = _overrelaxed([np.array([4.0, 3.0])], [np.array([2.0, 3.0])], 1.5)
+    np.testing.assert_allclose(out[0], [2.0 * 2.0**1.5, 3.0], rtol=1e-12)
+    np.testing.assert_allclose(_overrelaxed([np.array([4.0])], [np.array([2.0])], 1.0)[0],
+                               [4.0], rtol=1e-12)
+
+
+def test_scaled_peak_is_the_norm_of_the_d_scaled_loop():
+    """fit._scaled_peak: max over ω of σ̄(D̂_L(jω) M D̂_R(jω)⁻¹) (its docstring), for a 2x1
+    full block (one z row, two w columns of M: ``BlockStructure.shape_M``) and a 1x1
+    block, computed here with matrices from the fits' own responses: D̂_L = diag(d_1, d_2)
+    on M's rows, D̂_R = diag(d_1, d_1, d_2) on its columns, d_1 = (s + 2)/(s + 1),
+    d_2 = 1."""
+    from lmi_suspension.mu.steps.fit import _scaled_peak
+
+    struct = BlockStructure.coerce([[2, 1], [1, 1]])
+    assert struct.shape_M == (2, 3)
+    rng = np.random.default_rng(3)
+    w = np.array([0.1, 1.0, 3.0, 10.0])
+    M = rng.standard_normal((2, 3, w.size)) + 1j * rng.standard_normal((2, 3, w.size))
+    fits = [control.ss(control.tf([1.0, 2.0], [1.0, 1.0])), control.ss([], [], [], [[1.0]])]
+    ref = 0.0
+    for k, x in enumerate(1j * w):
+        d1 = complex(fits[0](x))
+        DL, DR = np.diag([d1, 1.0]), np.diag([d1, d1, 1.0])
+        ref = max(ref, np.linalg.norm(DL @ M[:, :, k] @ np.linalg.inv(DR), 2))
+    assert _scaled_peak(fits, M, w, struct) == pytest.approx(ref, rel=1e-12)

@@ -79,6 +79,7 @@ def test_hamiltonian_crossings_are_where_the_pointwise_level_crosses():
         assert np.min(np.abs(ev - 1j * wc)) <= 1e-6 * max(1.0, wc)
 
 
+@pytest.mark.slow  # 21 s on Zen 1 (2026-12-02): the second tier
 def test_mixed_bound_holds_between_grid_points():
     """Every pointwise LMI upper bound (the optimum over scalings at that ω) is at most
     the certified level: the interval's fixed scalings are feasible there.  And every

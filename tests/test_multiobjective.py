@@ -127,6 +127,7 @@ def test_peak_bound_is_active_certified_by_the_gramian_and_infeasible_when_too_t
         msyn(P, P.ny, P.nu, HinfBound(Channel(outputs=(0, 1))), [PeakBound(ch, (1e-9,))])
 
 
+@pytest.mark.slow  # 17 s on Zen 1 (2026-12-02): the second tier
 def test_hinf_bound_on_an_h2_objective_is_active():
     """The H2-optimal controller (row 2) of this plant has ‖T∞‖∞ = 20.7 on rows 0-1 and
     ‖T2‖₂ = 57.08 (measured 2026-11-25); under H∞ bounds of 60 and then 40 the H2 norm
@@ -235,6 +236,7 @@ def test_h2hinfsyn_weighted_search_finds_the_injected_pareto_minimum(monkeypatch
     assert normz4[0] == pytest.approx(g4, rel=2e-2) and normz4[0] > normz[0] * 1.1
 
 
+@pytest.mark.slow  # 47 s on Zen 1 (2026-12-02): the second tier
 def test_h2hinfsyn_matlab_conventions_and_certified_norms():
     """On a real plant: W = (1, 0) against the H∞ optimum of the H∞ channel alone by two
     other routes: SLICOT's γ iteration (python-control's hinfsyn: its γ, 9.95624; its

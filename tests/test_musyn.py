@@ -301,6 +301,7 @@ def test_overrelaxation_restarts_from_the_best_iterate():
     np.testing.assert_array_equal(res.K.A, h[1].K.A)
 
 
+@pytest.mark.slow  # 19 s on Zen 1 (2026-12-02): the second tier
 def test_overrelaxed_fit_that_peaks_off_the_grid_is_replaced():
     """On the default grid, the over-relaxed D-fit of iteration 3 matched its data on the
     grid (scaled peak 1.04) but the controller's norm on the scaled plant it gave was 1739
@@ -361,6 +362,7 @@ def _lundstrom_d():
                                                             * (s + 0.013))
 
 
+@pytest.mark.slow  # 30 s on Zen 1 (2026-12-02): the second tier
 def test_kstep_with_the_published_optimal_dscales_reaches_the_book_optimum():
     """The K-step and the µ analysis reach MATLAB's optimum when given its D-scales.
 
@@ -464,6 +466,7 @@ def test_best_certified_judges_the_controllers_of_every_realization_on_the_plant
         _best_certified(synthesis, PD, (broken,), 1, 1, HinfsynOptions(), [1.0, 2.0])
 
 
+@pytest.mark.slow  # 114 s on Zen 1 (2026-12-02): the second tier
 def test_dscale_search_improves_on_the_dk_step_and_is_certified():
     """search_dscales started from the D-step of the plain H∞ controller (µ 1.18): its
     first point is the next D-K step; it searches SLICOT's level, every point it accepts
@@ -888,6 +891,7 @@ def test_a_plain_rebuild_is_not_repeated_by_a_restart():
     assert source is best
 
 
+@pytest.mark.slow  # 68 s on Zen 1 (2026-12-02): the second tier
 def test_dk_after_the_search_is_dk_without_it_until_it_stops(monkeypatch):
     """The D-scale search runs once, from iteration 1's D-step, with its own copy of the
     generator: the D-K iterations after it are those of the run without it, to the
@@ -934,6 +938,7 @@ def test_dk_after_the_search_is_dk_without_it_until_it_stops(monkeypatch):
     assert search.mu_peak < min(h.mu_peak for h in loop)
 
 
+@pytest.mark.slow  # 31 s on Zen 1 (2026-12-02): the second tier
 def test_a_search_that_reaches_mu_target_ends_dk():
     """``mu_target`` = 1: the search from iteration 1's D-step stops at the first level
     below it (about 15-25 points on this grid), and D-K ends there: the first iterate,

@@ -156,8 +156,12 @@ def test_road_figures_are_each_seats_own_and_agree_with_time_stepping(K_refined)
     assert {name for _, _, name, _, _ in c.confirmed} == {"ratio", "u", "x1"}
     for _, _, _, fft, sim in c.confirmed:
         assert fft == pytest.approx(sim, rel=2e-3)
-    nominal = simulate(K_refined, road, delay=0.0, u_max=np.inf).metrics().peak_z3dd
-    assert c.nominal_ratio >= nominal / S.nominal_limit * (1 - 2e-3)
+    # the nominal seat's worst over the delays, by time stepping (its limit: the LP,
+    # in _samples): equal within the FFT's 0.2 %, on both sides (measured 5.5e-5 apart,
+    # 1.42612 against 1.42604 at 20 ms; 2026-12-01, Haswell and Sandybridge kernels)
+    nominal = max(simulate(K_refined, road, delay=d, u_max=np.inf).metrics().peak_z3dd
+                  for d in delays)
+    assert c.nominal_ratio == pytest.approx(nominal / S.nominal_limit, rel=2e-3)
 
 
 def test_certificate_rejects_bad_input(K_refined):

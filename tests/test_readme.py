@@ -35,12 +35,25 @@ def ci_commands() -> list[str]:
 def test_ci_runs_quickstart_line_two():
     commands = ci_commands()
     assert commands[0] == quickstart_lines()[1]
-    # then the numerical tests once more under another OpenBLAS kernel and thread count
-    assert len(commands) == 3
-    assert commands[1].startswith("OPENBLAS_CORETYPE=$other OPENBLAS_NUM_THREADS=$threads ")
-    assert "tests/test_hinfsyn.py" in commands[1] and "tests/test_musyn.py" in commands[1]
+    # line 2 runs the first tier on every core; the second tier is CI's named next step
+    assert " -n auto " in commands[0] and commands[0].endswith('-m "not slow"')
+    assert len(commands) == 4
+    assert commands[1].startswith("OPENBLAS_CORETYPE=$other ") and " -m slow " in commands[1]
+    assert "--nbmake" in commands[1] and " -n auto " in commands[1]
+    # then the first tier's numerical tests once more under another kernel and thread count
+    assert commands[2].startswith("OPENBLAS_CORETYPE=$other OPENBLAS_NUM_THREADS=2 ")
+    assert '-m "not slow"' in commands[2] and " -n " not in commands[2]
+    assert "tests/test_hinfsyn.py" in commands[2] and "tests/test_musyn.py" in commands[2]
     # then the documentation, built by the README's command, warnings as errors
-    assert commands[2] == docs_command() and " -W " in commands[2]
+    assert commands[3] == docs_command() and " -W " in commands[3]
+
+
+def test_every_test_runs_in_one_of_the_two_tiers():
+    """The first tier (``-m "not slow"``) and the second (``-m slow``) together are the
+    whole suite: neither step of ``.ci/run`` narrows the selection by path."""
+    first, second = ci_commands()[:2]
+    assert not re.search(r"\b(tests|notebooks|lmi_suspension)/", first + second)
+    assert "-k " not in first + second
 
 
 #: test modules that run iterative numerics but stay out of the second pass: they run
@@ -57,7 +70,7 @@ def test_second_pass_names_every_iterative_numerical_module():
     """Issue 36: every test module of an iterative numerical algorithm runs twice in CI,
     the second time under another kernel and thread count (so roundoff-fragile
     assertions fail in CI before they fail on a user's CPU)."""
-    second = set(re.findall(r"tests/(test_\w+\.py)", ci_commands()[1]))
+    second = set(re.findall(r"tests/(test_\w+\.py)", ci_commands()[2]))
     assert all((ROOT / "tests" / name).exists() for name in second), second
     iterative = {p.name for p in (ROOT / "tests").glob("test_*.py")
                  if _ITERATIVE.search(p.read_text())}

@@ -149,6 +149,7 @@ def test_a_worse_stage_is_rejected_and_the_box_halved(K_mu, monkeypatch):
     assert np.allclose(d.K.B, start.B) and np.allclose(d.K.D, start.D)
 
 
+@pytest.mark.slow  # 22 s on Zen 1 (2026-12-02): the second tier
 def test_the_sets_robust_stability_enters_every_stage(monkeypatch):
     """With ``occupants``, the set's mixed-µ bound is a requirement: injected, SLSQP
     returns its start, so both stages are rejected and the controller stays the first
@@ -181,6 +182,7 @@ def test_the_sets_robust_stability_enters_every_stage(monkeypatch):
         assert np.allclose(a, b, rtol=1e-12, atol=0)
 
 
+@pytest.mark.slow  # 79 s on Zen 1 (2026-12-02): the second tier
 def test_a_short_search_lowers_the_violation(K_mu, monkeypatch):
     """From the µ controller (it asks 2574 N of the 1500 N on the bump), two short
     stages: every accepted stage is better, and the result's figures are what the FFT

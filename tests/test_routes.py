@@ -82,6 +82,7 @@ def test_the_certificate_bounds_the_bump_by_the_routes_own_guarantee(peak_bounde
         np.max(np.abs(np.linalg.eigvals(peak_bounded.K.A))), rel=1e-9)
 
 
+@pytest.mark.slow  # 18 s on Zen 1 (2026-12-02): the second tier
 def test_the_mu_route_through_the_entry_is_the_paper_design():
     """The µ route (seconds) through design_seat: the controller of design_mu_controller
     called directly with the same seed, bit for bit, and its figures."""
@@ -141,6 +142,34 @@ def test_the_searched_worst_seats_are_judged():
                                       "c3 1485 N s/m, 0 ms, above 0.08",)
 
 
+def test_the_sets_mixed_mu_is_judged_against_one():
+    """The set's mixed µ (constructed, no design run): ``rs_sup < 1`` certifies robust
+    stability over the set (MixedMuCheck), so just below 1 passes, 1 itself and above
+    fail, and a nan fails; the performance figure is not judged (rp_sup 5 passes)."""
+    from types import SimpleNamespace
+
+    from lmi_suspension.seat.occupants import MixedMuCheck
+
+    # a certificate that meets everything else: no delays (the bump not judged), a
+    # delay margin above 25 ms, no pole
+    base = SeatCertificate(delays=(), peak=(), u_peak=(), x1_peak=(), sampled_peak=(),
+                           mu=SimpleNamespace(controller_fastest_pole=0.0),
+                           delay_margin=math.inf, loop_radius=0.0)
+    assert base.mixed_mu is None and base.met
+
+    def judged(rs_sup):
+        check = MixedMuCheck(block_names=("m3", "delay", "performance"), rs_upper=rs_sup,
+                             rs_lower=0.5, rp_upper=5.0, rp_lower=4.0, rs_omega=10.0,
+                             rp_omega=10.0, omega=np.array([1.0, 10.0]), rs_sup=rs_sup,
+                             rp_sup=5.0)
+        return dataclasses.replace(base, mixed_mu=check).failures()
+
+    assert judged(0.999) == () and judged(0.5) == ()
+    assert judged(1.0) == ("set: robust-stability mixed µ 1.0000, not below 1",)
+    assert judged(1.01) == ("set: robust-stability mixed µ 1.0100, not below 1",)
+    assert judged(math.nan) == ("set: robust-stability mixed µ nan, not below 1",)
+
+
 def test_the_passive_seat_is_judged_against_the_requirements():
     """The passive seat: no force, its bump peak 4.3 × the limit (the limit is a lower
     bound for every force history, the passive one's included)."""
@@ -168,6 +197,7 @@ def test_the_passive_seat_is_judged_against_the_requirements():
     assert any(f.startswith("delay margin") for f in unstable.failures())
 
 
+@pytest.mark.slow  # 16 s on Zen 1 (2026-12-02): the second tier
 def test_certify_refined_is_the_one_certificate_with_the_refinements_delays():
     from lmi_suspension.seat.refine import REFINE_DELAYS
 
@@ -283,6 +313,7 @@ def test_bad_input_is_refused_with_typed_errors():
                                                       rng=np.random.default_rng(0))
 
 
+@pytest.mark.slow  # 60 s on Zen 1 (2026-12-02): the second tier
 def test_the_set_is_certified_and_judged_when_samples_are_given(peak_bounded):
     """A few samples of the set (the occupant figures have their own tests): the
     certificate carries them and judges the set's worst ratio and force."""
@@ -304,3 +335,38 @@ def test_the_set_is_certified_and_judged_when_samples_are_given(peak_bounded):
     r = c.requirements
     assert sum(f.startswith("set, searched:") for f in failures) == (
         (not u.value <= r.u_max) + (not x1.value <= r.z_max))
+
+
+# ---------------------------------------------------------------- mutation pass (issue 59)
+def test_the_requirement_edges_are_judged_as_stated():
+    """SeatRequirements' docstring at its edges (constructed certificates, no design
+    run): the delay margin must lie above ``delay_max`` (equal fails); every pole of the
+    controller or the loop below ``pole_radius`` (the controller's alone at it fails);
+    the 1 kHz loop's peak within ``sampled_tolerance`` of the continuous one's, either
+    side (5 % below fails); the set's fastest loop pole below ``pole_radius`` too."""
+    from types import SimpleNamespace
+
+    r = SeatRequirements(nominal_ratio=100.0)
+    base = SeatCertificate(delays=(0.0,), peak=(10.0,), u_peak=(0.0,), x1_peak=(0.0,),
+                           sampled_peak=(10.0,),
+                           mu=SimpleNamespace(controller_fastest_pole=0.0),
+                           delay_margin=math.inf, loop_radius=0.0, limit=5.0,
+                           requirements=r)
+    assert base.failures() == ()
+
+    def failed(**changes):
+        """The requirements the changed certificate fails, by their lines' openings."""
+        return [f.split(":")[0] if ":" in f else " ".join(f.split()[:2])
+                for f in dataclasses.replace(base, **changes).failures()]
+
+    assert failed(delay_margin=r.delay_max * (1 + 1e-9)) == []
+    assert failed(delay_margin=r.delay_max) == ["delay margin"]
+    assert failed(mu=SimpleNamespace(controller_fastest_pole=r.pole_radius)) == ["poles"]
+    assert failed(sampled_peak=(10.0 * (1 - 0.99 * r.sampled_tolerance),)) == []
+    assert failed(sampled_peak=(9.5,)) == ["1 kHz loop's peak against the continuous one"]
+    occupants = SimpleNamespace(unstable=0, n_stability=10, worst_ratio=1.0,
+                                nominal_ratio=1.0, u_max=0.0, x1_max=0.0,
+                                loop_radius=r.pole_radius * (1 - 1e-9))
+    assert failed(occupants=occupants) == []
+    occupants.loop_radius = r.pole_radius
+    assert failed(occupants=occupants) == ["set"]

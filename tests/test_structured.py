@@ -133,6 +133,37 @@ def test_the_kkt_solve_satisfies_the_kkt_equations(small, ill, minres):
     W = _random_scaling(prob, rng)
     f = prob.kktsolver(W)
     assert prob.regularised == int(ill)
+    rx, rz = _kkt_residuals(prob, W, f, rng)
+    assert rx < 1e-8 and rz < 1e-8
+
+
+def test_an_unregularised_solve_is_refined_against_an_inexact_factor(small, monkeypatch):
+    """Injected: the Schur complement factorises without regularisation, but its
+    factor is wrong in the 6th digit (as near an optimum, where the factorisation is
+    inaccurate though it succeeds: ``_REFINEMENT_STEPS``).  Only the refinement
+    against the complement applied as ``G̃ᵀ G̃`` brings the KKT residual back: measured
+    (AC4, this scaling, 2026-12-01, Haswell and Sandybridge kernels) ``Gᵀ uz - bx`` at
+    9.7e-2 of ``bx`` with no refinement step, 4.5e-5 with one, 2.2e-8 with two and
+    5.5e-12 at most with three; the KKT test's 1e-8 is asserted."""
+    prob, _ = small
+
+    def inexact(M, **kw):
+        L, lower = _CHO_FACTOR(M, **kw)
+        E = np.tril(np.random.default_rng(1).standard_normal(L.shape))
+        return np.tril(L) + 1e-6 * E * np.abs(np.diag(L))[None, :], lower
+
+    monkeypatch.setattr(structured.scipy.linalg, "cho_factor", inexact)
+    rng = np.random.default_rng(3)
+    W = _random_scaling(prob, rng)
+    f = prob.kktsolver(W)
+    assert prob.regularised == 0 and prob._level == 0
+    rx, rz = _kkt_residuals(prob, W, f, np.random.default_rng(4))
+    assert rx < 1e-8 and rz < 1e-8
+
+
+def _kkt_residuals(prob, W, f, rng):
+    """Solve the KKT system with ``f`` for random right-hand sides; return the relative
+    residuals of ``Gᵀ uz = bx`` and ``G ux - Wᵀ W uz = bz``."""
     bx = cvxopt.matrix(rng.standard_normal(prob.m))
     bz = _random_cone_vector(prob, rng)
     x, z = cvxopt.matrix(bx), cvxopt.matrix(bz)
@@ -150,7 +181,7 @@ def test_the_kkt_solve_satisfies_the_kkt_equations(small, ill, minres):
     rx = np.linalg.norm(np.array(GTuz - bx)) / np.linalg.norm(np.array(bx))
     res_z = Gux - WTWuz - bz
     rz = np.sqrt(misc.sdot(res_z, res_z, prob.dims) / misc.sdot(bz, bz, prob.dims))
-    assert rx < 1e-8 and rz < 1e-8
+    return rx, rz
 
 
 @pytest.mark.parametrize("name", ["AC4", "HE1", "REA2", "NN2"])
@@ -255,7 +286,8 @@ def test_refined_solves_keep_the_cholesky_run_on_the_decades_plant():
     Sandybridge, Nehalem and SkylakeX (measured 2026-11-29).  Since the complement's
     assembly changed (``_Basis.add_pairs``) it ends optimal under every kernel even
     without the unregularised refinement: this test no longer pins that refinement
-    (a refinement that diverges, its correction's sign flipped, still fails it)."""
+    (a refinement that diverges, its correction's sign flipped, still fails it);
+    ``test_an_unregularised_solve_is_refined_against_an_inexact_factor`` does."""
     sol = _minimise(_random_plant(2374001, max_states=4))
     assert sol.status == "optimal" and sol.kkt == "Cholesky"
 
@@ -352,13 +384,13 @@ def _factorisations(monkeypatch, fail_from):
     return count
 
 
-def _minimise(P):
+def _minimise(P, options=OPTS):
     Ps, _ = scale_plant(P)
     n = Ps.nstates
     proj_r, proj_s = lmi._projections(*lmi.Frame.identity(n).plants(Ps), True)
     return structured.minimise_gamma([(proj_r, False), (proj_s, True)],
-                                     proj_r.T.T @ proj_s.T, OPTS.xy_bound * n, OPTS.margin,
-                                     OPTS)
+                                     proj_r.T.T @ proj_s.T, options.xy_bound * n,
+                                     options.margin, options)
 
 
 def test_a_run_stopped_near_the_optimum_is_optimal_inaccurate(monkeypatch):
@@ -382,20 +414,25 @@ def test_a_run_stopped_near_the_optimum_is_optimal_inaccurate(monkeypatch):
     assert any("CVXOPT stopped short" in w for w in sol.warnings)
 
 
-def test_of_two_near_misses_the_one_with_smaller_residuals_is_returned(monkeypatch):
-    """Injected: both runs end "unknown" within the reduced tolerances, the Cholesky
-    run with residuals of 5e-7 and the MINRES run with 1e-7 (their iterates are the
-    real optima, relabelled).  The MINRES run's is returned, "optimal_inaccurate"."""
+@pytest.mark.parametrize("cholesky_res, minres_res, kept",
+                         [(5e-7, 1e-7, "MINRES"), (1e-7, 5e-7, "Cholesky")],
+                         ids=["the-later-closer", "the-earlier-closer"])
+def test_of_two_near_misses_the_one_with_smaller_residuals_is_returned(
+        monkeypatch, cholesky_res, minres_res, kept):
+    """Injected: both runs end "unknown" within the reduced tolerances, one with
+    residuals of 5e-7 and the other with 1e-7 (their iterates are the real optima,
+    relabelled), in either order.  The closer run's is returned, "optimal_inaccurate",
+    whether it ran first or second."""
     real = cvxopt.solvers.conelp
 
     def near_misses(c, G, h, dims, kktsolver, options):
-        res = 1e-7 if kktsolver.__self__.minres else 5e-7
+        res = minres_res if kktsolver.__self__.minres else cholesky_res
         return {**real(c, G, h, dims, kktsolver=kktsolver, options=options),
                 "status": "unknown", "primal infeasibility": res, "dual infeasibility": res}
 
     monkeypatch.setattr(structured.cvxopt.solvers, "conelp", near_misses)
     sol = _minimise(compleib("AC4"))
-    assert sol.status == "optimal_inaccurate" and sol.kkt == "MINRES"
+    assert sol.status == "optimal_inaccurate" and sol.kkt == kept
 
 
 def test_a_run_stopped_far_from_the_optimum_is_a_solver_error(monkeypatch):
@@ -433,3 +470,109 @@ def test_the_operator_is_the_projected_inequalities(name, sparse):
     np.testing.assert_array_equal(C[:n, :n], -Rt)
     np.testing.assert_array_equal(C[n:, n:], -St)
     assert not C[:n, n:].any()
+
+
+# ---------------------------------------------------------------- mutation pass (issue 59)
+def test_the_regularisation_ladder_adds_each_rung_once_and_resumes_at_the_last(small,
+                                                                              monkeypatch):
+    """Injected: the equilibrated complement (unit diagonal) fails to factorise twice.
+    Each attempt must add exactly its rung of ``_REGULARISATION`` to the diagonal (the
+    previous rung taken off, not summed: 0, then 1e-13, then 1e-11), and the next
+    complement must start at the rung that worked (the ladder's docstring).  Reference:
+    the diagonal that reaches the factorisation, read here, minus the 1 of the
+    equilibration (rounding of ``1 + δ`` is 1.1e-16 absolute, hence ``abs=1e-15``)."""
+    prob, _ = small
+    seen, fail = [], [2]
+
+    def spy(M, **kw):
+        seen.append(np.diag(M) - 1.0)
+        if fail[0]:
+            fail[0] -= 1
+            raise np.linalg.LinAlgError("injected")
+        return _CHO_FACTOR(M, **kw)
+
+    monkeypatch.setattr(structured.scipy.linalg, "cho_factor", spy)
+    W = _random_scaling(prob, np.random.default_rng(7))
+    prob.kktsolver(W)
+    rungs = structured._REGULARISATION
+    assert len(seen) == 3
+    for diag, rung in zip(seen, rungs[:3]):
+        np.testing.assert_allclose(diag, rung, rtol=0, atol=1e-15)
+    assert prob._level == 2 and prob.regularised == 1
+    prob.kktsolver(W)  # no failure now: one attempt, at the rung the last one needed
+    assert len(seen) == 4
+    np.testing.assert_allclose(seen[3], rungs[2], rtol=0, atol=1e-15)
+    assert prob.regularised == 2
+
+
+def _conelp_settings(monkeypatch, options):
+    """The settings ``minimise_gamma`` gives CVXOPT (the spy ends each run at once, so
+    both runs are tried and a SolverError follows)."""
+    seen = []
+
+    def spy(c, G, h, dims, kktsolver, options):
+        seen.append(dict(options))
+        raise ValueError("injected: stop here")
+
+    monkeypatch.setattr(structured.cvxopt.solvers, "conelp", spy)
+    with pytest.raises(SolverError, match="injected"):
+        _minimise(compleib("AC4"), options)
+    return seen
+
+
+def test_cvxopts_iterations_and_feasibility_tolerance_are_bounded(monkeypatch):
+    """``minimise_gamma``'s docstring: ``max_iter`` at most ``_MAX_ITERATIONS`` and
+    ``feastol`` at least ``_FEASTOL``, the user's value where it is stricter or looser
+    respectively (read from the settings CVXOPT receives, both runs)."""
+    loose = dataclasses.replace(OPTS, max_iter=500, tol_feas=1e-9)
+    for s in _conelp_settings(monkeypatch, loose):
+        assert s["maxiters"] == structured._MAX_ITERATIONS == 60
+        assert s["feastol"] == structured._FEASTOL == 1e-7
+    strict = dataclasses.replace(OPTS, max_iter=20, tol_feas=1e-5)
+    seen = _conelp_settings(monkeypatch, strict)
+    assert len(seen) == 2 and all(s["maxiters"] == 20 and s["feastol"] == 1e-5 for s in seen)
+
+
+def test_out_of_memory_ends_the_solve_without_the_second_run(monkeypatch):
+    """Injected: CVXOPT runs out of memory in the Cholesky run.  The MINRES run would need
+    as much (the complement is the same size), so it is not tried: one call, and a
+    SolverError that says so (Clarabel then takes over in ``gamma_lmi``)."""
+    calls = []
+
+    def oom(c, G, h, dims, kktsolver, options):
+        calls.append(kktsolver.__self__.minres)
+        raise MemoryError("injected")
+
+    monkeypatch.setattr(structured.cvxopt.solvers, "conelp", oom)
+    with pytest.raises(SolverError, match="out of memory"):
+        _minimise(compleib("AC4"))
+    assert calls == [False]
+
+
+def test_the_trace_multiplier_bounds_the_optimums_slope_in_the_trace_bound():
+    """``trace_multiplier`` is the dual multiplier of ``trace(R̃) + trace(S̃) <= b``, so
+    by convexity of the optimum γ*(b) (its field's comment) it lies between the
+    difference quotients on either side of ``b``:
+    ``(γ*(b) - γ*(2b)) / b <= λ <= (γ*(b/2) - γ*(b)) / (b/2)``.  The three optima are
+    solved here; ``b`` is a tenth of the trace at the optimum under the default bound
+    ``xy_bound n``, so the bound is active and λ > 0 (γ* 8.7e-5 above; the quotients
+    1.5e-10 and 1.8e-9 about λ = 8.6e-10, measured 2026-12-01 under the Haswell and
+    Sandybridge kernels).  Slack: each optimum is within CVXOPT's gap tolerance of the
+    true one, ``max(tol_gap_abs, tol_gap_rel γ)`` = 1e-7 here, twice that per
+    difference of optima (the smaller difference is 5.7e-6)."""
+    Ps, _ = scale_plant(compleib("AC4"))
+    n = Ps.nstates
+    proj_r, proj_s = lmi._projections(*lmi.Frame.identity(n).plants(Ps), True)
+
+    def solve(b):
+        return structured.minimise_gamma([(proj_r, False), (proj_s, True)],
+                                         proj_r.T.T @ proj_s.T, b, OPTS.margin, OPTS)
+
+    free = solve(OPTS.xy_bound * n)
+    b = 0.1 * float(np.trace(free.Rt) + np.trace(free.St))
+    mid, wide, narrow = solve(b), solve(2 * b), solve(b / 2)
+    assert all(s.status == "optimal" for s in (free, mid, wide, narrow))
+    slack = 2 * max(OPTS.tol_gap_abs, OPTS.tol_gap_rel * mid.gamma)
+    assert mid.gamma > free.gamma * (1 + 1e-6)                    # the bound is active
+    assert (mid.gamma - wide.gamma - slack) / b <= mid.trace_multiplier
+    assert mid.trace_multiplier <= (narrow.gamma - mid.gamma + slack) / (b / 2)

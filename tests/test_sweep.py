@@ -430,6 +430,7 @@ def test_an_interrupted_sweep_resumes_where_it_stopped(tmp_path, controller_file
 # ----------------------------------------------------------------- dask
 
 
+@pytest.mark.slow  # 20 s on Zen 1 (2026-12-02): the second tier
 def test_local_cluster_of_two_processes_gives_the_same_rows_in_any_order(
         tmp_path, controller_file, reference):
     spec = _spec(controller_file)
@@ -589,6 +590,7 @@ def test_cli_sweep_bad_sampling_is_one_line_exit_2(tmp_path, argv, match, capsys
 # ----------------------------------------------------------------- per-case designs
 
 
+@pytest.mark.slow  # 20 s on Zen 1 (2026-12-02): the second tier
 def test_design_entry_synthesises_one_controller_per_distinct_seat(tmp_path, monkeypatch):
     """Every case of one seat runs the µ controller designed for that seat, designed once."""
     from lmi_suspension.seat import design as design_module
@@ -615,6 +617,7 @@ def test_design_entry_synthesises_one_controller_per_distinct_seat(tmp_path, mon
         assert row["stable"] == closed_loop_stable(K, row["delay"], SeatParameters(m3=60.0))
 
 
+@pytest.mark.slow  # 26 s on Zen 1 (2026-12-02): the second tier
 def test_a_design_entry_can_name_any_route(tmp_path):
     """``design:<route>``: the peak-bounded route designed for each seat of the grid (once
     each), its rows equal to a direct design and simulation."""

@@ -146,10 +146,10 @@ def test_ultidyn_and_nominal_and_usample():
 ])
 def test_bad_input_is_a_typed_error_naming_the_parameter(build, err, text):
     t0 = time.perf_counter()
-    with pytest.raises(err, match=text):
+    with pytest.raises(err, match=text) as raised:
         build()
     assert time.perf_counter() - t0 < 1.0
-    assert issubclass(err, ValueError)
+    assert isinstance(raised.value, ValueError)  # what was raised, not the table's entry
 
 
 def test_robstab_refuses_unstable_nominal():
@@ -185,13 +185,21 @@ def test_robstab_third_order_closed_form():
 
 
 def test_robstab_ultidyn_small_gain():
-    P = control.tf([2.0], [1, 0.5, 4])  # peak gain from hinfnorm
+    """One full dynamic block: by the small-gain theorem (exact for an unstructured
+    block) the margin is 1 / (bound ‖P‖∞), with ‖P‖∞ in closed form: |P(jω)|² =
+    4 / ((4 - ω²)² + ω²/4) peaks at ω² = 4 - 1/8, so ‖P‖∞ = 2 / sqrt(1/64 + 3.875/4).
+    The bounds must bracket it: a lower bound above it, or an upper bound below it, is
+    wrong (measured 2026-12-01, Haswell and Sandybridge: lower 4.4e-15 above it, its
+    peak search's roundoff, and upper 2.0 % above it; 1e-9 allowed for roundoff)."""
+    P = control.tf([2.0], [1, 0.5, 4])
     D = ultidyn("D", (1, 1), bound=0.25)
     T = feedback(uss(P), D)
-    gP = hinfnorm(P)[0]
+    gP = 2.0 / np.sqrt(1 / 64 + 3.875 / 4)  # the closed form above
+    assert hinfnorm(P)[0] == pytest.approx(gP, rel=1e-9)
+    margin = 1 / (0.25 * gP)
     r = robstab(T, W60)
     assert r.lower <= r.upper
-    assert r.lower <= 1 / (0.25 * gP) * 1.001 and r.upper >= 1 / (0.25 * gP) * 0.99
+    assert r.lower <= margin * (1 + 1e-9) and r.upper >= margin * (1 - 1e-9)
     assert r.upper / r.lower - 1 < 0.05 and r.checked
 
 
@@ -404,3 +412,76 @@ def test_reduction_keeps_a_parameter_beside_large_certain_dynamics():
         direct = control.ss([[value]], [[1.0]], [[1.0]], [[0.0]]) + fast
         np.testing.assert_allclose(freqresp(usubs(G, {"a": value}), w), freqresp(direct, w),
                                    rtol=1e-9)
+
+
+# ---------------------------------------------------------------- mutation pass (issue 59)
+def test_a_repeated_multivariable_ultidyn_is_refused_and_a_scalar_one_repeats():
+    """A 1x2 ultidyn entering twice (``D + D``) has no LFT with one full block: refused,
+    naming it; a SISO one entering twice is the repeated block ``[2, 0]`` (lfr's
+    ``UBlock.blk_row``)."""
+    D = ultidyn("D", (1, 2))
+    with pytest.raises(ParameterError, match="ultidyn 'D' .1x2. enters the model 2 times"):
+        D + D
+    E = ultidyn("E", (1, 1))
+    assert lftdata(uss([[E, 0], [0, E]])).blk.to_blk().tolist() == [[2, 0]]
+
+
+@pytest.mark.parametrize("shape, bound", [((1, 1), 0.25), ((2, 2), 0.5)])
+def test_usample_draws_ultidyn_values_within_the_bound(shape, bound):
+    """``usample``'s docstring: an ultidyn is a gain of norm <= bound times an all-pass,
+    so every sample's H∞ norm (hinfnorm, here) is at most the bound; the draws fill the
+    ball (largest of 20 above half the bound: 0.974 and 0.992 of it, measured
+    2026-12-01)."""
+    D = ultidyn("D", shape, bound=bound)
+    systems, values = usample(uss(D), 20, np.random.default_rng(5))
+    norms = [hinfnorm(s)[0] for s in systems]
+    assert max(norms) <= bound * (1 + 1e-9) and max(norms) > 0.5 * bound
+    assert all(v["D"] is not None for v in values)
+
+
+@pytest.mark.parametrize("A", [lambda k: [[0, 1], [0, -k]], lambda k: [[0, 1], [-k, 0]]],
+                         ids=["pole at 0", "poles at ±j"])
+def test_robstab_refuses_a_nominal_pole_on_the_imaginary_axis(A):
+    """x'' = -k x' has poles 0 and -k, x'' = -k x the pair ±j sqrt(k) (k = 1 nominal):
+    not stable, so no margin exists; both are refused, not analysed."""
+    k = ureal("k", 1.0, plusminus=0.1)
+    with pytest.raises(AssumptionError, match="not stable"):
+        robstab(uss(A(k), [[0], [1]], [[1, 0]], [[0]]))
+
+
+def test_wcgain_upper_bounds_the_gain_at_a_complex_perturbation():
+    """1/(s² + 0.2 s + a), ``a = 1 + 0.1 δ`` complex: at ω = 1 (a grid frequency, the
+    nominal poles' magnitude) the gain is 1/|0.2 j + 0.1 δ|, which δ = -j makes
+    1/(0.2 - 0.1) = 10; the upper bound must be at least that (a closed form the µ
+    bounds do not use).  Real values of δ reach only about 5.3 there (the lower bound's
+    search): the two are apart, so the upper bound is the skewed-µ bisection's, not
+    the lower bound's level (measured 10.08 and 5.30, 2026-12-01)."""
+    a = ucomplex("a", 1.0, 0.1)
+    g = wcgain(uss([[0, 1], [-a, -0.2]], [[0], [1]], [[1, 0]], [[0]]))
+    assert g.lower <= g.upper and np.isfinite(g.upper)
+    assert g.upper >= 10.0 * (1 - 1e-9)
+
+
+def test_robstab_reports_an_ultidyn_worst_case_in_physical_units():
+    """feedback(P, Δ) = P/(1 + P Δ) loses stability where 1 + P(jω) Δ(jω) = 0.  The
+    reported ``worst["D"]`` is Δ(jω_c) itself (physical: normalised size ``upper`` times
+    the bound 0.5), and 1 + P(jω_c) worst vanishes, with P's response evaluated here
+    (measured 6e-16, 2026-12-01; 1e-9 allowed)."""
+    P = control.tf([1.0], [1, 0.4, 2])
+    D = ultidyn("D", (1, 1), bound=0.5)
+    r = robstab(feedback(uss(P), D))
+    delta = complex(np.asarray(r.worst["D"]).ravel()[0])
+    assert abs(delta) == pytest.approx(r.upper * 0.5, rel=1e-9)
+    assert abs(1 + complex(P(1j * r.critical_frequency)) * delta) <= 1e-9
+
+
+def test_robstab_exact_takes_the_nearer_of_crossings_on_both_sides():
+    """x'' + c x' + x with c = (1 + 2δ)(1 - δ): stable iff c > 0 (Routh-Hurwitz), so the
+    loop crosses at δ = 1 and at δ = -1/2, and the margin is the nearer, 1/2, at
+    c = 0 (the pole pair at ±j)."""
+    d = ureal("d", 0.0, plusminus=1.0)
+    r = robstab(_second_order(1, (1 + 2 * d) * (1 - d)))
+    assert r.method == "exact" and not r.warnings
+    assert r.lower <= 0.5 * (1 + 1e-9) and 0.5 * (1 - 1e-9) <= r.upper
+    assert r.worst["d"] == pytest.approx(-0.5, abs=1e-9)
+    assert r.critical_frequency == pytest.approx(1.0, rel=1e-6)

@@ -159,3 +159,51 @@ def test_worst_seat_describes_where_and_knows_its_figures():
     assert gone["text"].startswith("unstable at")
     with pytest.raises(ParameterError, match="figure"):
         WorstSeat(figure="z", value=1.0, seat=SeatParameters(), delay=0.0, evaluations=1)
+
+
+# ---------------------------------------------------------------- mutation pass (issue 59)
+def test_the_climb_reaches_an_interior_maximum_of_constructed_figures(monkeypatch):
+    """The climbs must go uphill from the worst seats.  Constructed figures (the road
+    figures, the loop's poles, the stability check and the time simulation injected):
+    the force is 1000 - 500 (t - 0.6)² N, t the unit coordinate of k1 in its range, so
+    its maximum, 1000 N at t = 0.6, lies inside the box, where no corner (920 N at most)
+    nor a corner's finite-difference probe comes near it; the stroke is largest at the corner
+    m3 = 70 kg (0.06 m).  Reference: these closed forms; the climb met the force's peak
+    to 9e-10 and its k1 to 2e-5 (measured 2026-12-01, Haswell and Sandybridge kernels),
+    1e-6 and 1e-3 allowed."""
+    import importlib
+    from types import SimpleNamespace
+
+    refine = importlib.import_module("lmi_suspension.seat.refine")
+    simulation = importlib.import_module("lmi_suspension.seat.simulate")
+    occ = OccupantSet()
+    _, lo, hi = occ.ranges()[1]
+    assert occ.ranges()[1][0] == "k1"
+
+    def force(p):
+        return 1000.0 - 500.0 * ((p.k1 - lo) / (hi - lo) - 0.6) ** 2
+
+    def stroke(p):
+        return 0.05 + 0.01 * (p.m3 - 30.0) / 40.0
+
+    class Response:
+        def __init__(self, road, delays, params):
+            self.p, self.n = params, len(delays)
+
+        def peaks(self, K):
+            return (np.zeros(self.n), np.full(self.n, force(self.p)),
+                    np.full(self.n, stroke(self.p)))
+
+    def simulate(K, road, *, delay, params, u_max):
+        figures = SimpleNamespace(peak_u_command=force(params), peak_x1=stroke(params))
+        return SimpleNamespace(metrics=lambda: figures)
+
+    monkeypatch.setattr(refine, "BumpResponse", Response)
+    monkeypatch.setattr(refine, "loop_poles", lambda K, p: np.array([-1.0]))
+    monkeypatch.setattr(simulation, "closed_loop_stable", lambda K, d, p: True)
+    monkeypatch.setattr(simulation, "simulate", simulate)
+    u, x1 = worst_bump_seats(control.ss([], [], [], [[0.0, 0.0]]), occ,
+                             rng=np.random.default_rng(0), n=0, starts=1, delays=0.0)
+    assert u.value == pytest.approx(1000.0, rel=1e-6) and u.frequency_value == u.value
+    assert u.seat.k1 == pytest.approx(lo + 0.6 * (hi - lo), rel=1e-3)
+    assert x1.value == pytest.approx(0.06, rel=1e-12) and x1.seat.m3 == 70.0
