@@ -19,6 +19,8 @@ __all__ = [
     "InfeasibleError",
     "SolverError",
     "IterationLimitError",
+    "NotBuiltError",
+    "RateBoundNotBuiltError",
 ]
 
 
@@ -77,3 +79,13 @@ class SolverError(LmiSuspensionError):
 
 class IterationLimitError(LmiSuspensionError):
     """An iterative routine reached its iteration bound without meeting its test."""
+
+
+class NotBuiltError(LmiSuspensionError, NotImplementedError):
+    """A documented capability that is not built yet; the message says which, and what
+    works instead."""
+
+
+class RateBoundNotBuiltError(NotBuiltError):
+    """:func:`~lmi_suspension.lpv.lpvsyn` was asked for a nonzero rate bound ν: only
+    parameters frozen during operation (ν = 0) are built."""

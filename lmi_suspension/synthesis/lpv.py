@@ -1,0 +1,625 @@
+"""Gridded gain-scheduled H∞ output-feedback synthesis (:func:`lpvsyn`), parameters frozen
+during operation (rate bound ν = 0).
+
+The plant ``P(p)`` is given on a grid of a measured parameter vector ``p`` (a callable
+``p -> StateSpace``, or a list of ``(p, plant)`` pairs whose matrices are interpolated
+linearly between grid points, as LPVTools does for gridded systems).  The Lyapunov
+matrices of the projected (controller-eliminated) H∞ LMIs of Gahinet & Apkarian (1994)
+are made parameter dependent, ``X(p) = Σ f_i(p) X_i`` and ``Y(p) = Σ f_i(p) Y_i`` with
+user basis functions ``f`` (default ``[1, p_1, ..., p_k]``), and at every grid point ``p_g``::
+
+    W_R(p_g)ᵀ BRL_R(A, B1, C1, D11 at p_g; X(p_g), γ) W_R(p_g) < 0
+    W_S(p_g)ᵀ BRL_S(A, B1, C1, D11 at p_g; Y(p_g), γ) W_S(p_g) < 0
+    [[X(p_g), I], [I, Y(p_g)]] >= 0,   trace X(p_g) + trace Y(p_g) <= xy_bound n
+
+with ``W_R``, ``W_S`` the null-space bases of ``[B2ᵀ D12ᵀ]`` and ``[C2 D21]`` *at that
+point* (so ``B2``, ``C2``, ``D12``, ``D21`` may depend on ``p``, unlike the polytopic
+route); γ is minimised (one SDP, Clarabel through CVXPY, the building blocks and
+settings of :mod:`.lmi`).  With ν = 0 the Lyapunov inequalities carry no ``∂X/∂p ṗ``
+term (Wu et al. 1996, Apkarian & Adams 1998 with a zero rate bound): the controller is
+guaranteed **for frozen parameters** — for each constant ``p`` the loop is stable with
+``‖F_l(P(p), K(p))‖∞`` below the level — and nothing is claimed for a ``p`` that moves
+during operation; slowly varying parameters need ν > 0, which is not built yet
+(:class:`RateBoundNotBuiltError`).
+
+The scheduled controller is formed at any ``p`` (between grid points too) from
+``X(p)``, ``Y(p)`` and ``P(p)`` by the project's explicit formulas
+(:func:`~lmi_suspension.synthesis.lmi.decoupled_controller`, Gahinet 1996) at the level
+``(1 + backoff) γ_lmi`` with ``(X, Y)`` scaled by ``sqrt(1 + backoff)``, as
+:func:`~lmi_suspension.synthesis.hinfsyn` does on one plant; every frozen loop on a grid
+at least 4 times denser than the design grid is certified by ``hinfnorm``.
+
+References
+----------
+P. Gahinet, P. Apkarian, "A linear matrix inequality approach to H∞ control", Int. J.
+Robust Nonlinear Control 4 (1994) 421-448.
+F. Wu, X. H. Yang, A. Packard, G. Becker, "Induced L2-norm control for LPV systems with
+bounded parameter variation rates", Int. J. Robust Nonlinear Control 6 (1996) 983-998.
+P. Apkarian, R. J. Adams, "Advanced gain-scheduling techniques for uncertain systems",
+IEEE Trans. Control Systems Technology 6(1) (1998) 21-32.
+"""
+
+from __future__ import annotations
+
+import itertools
+import numbers
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import control
+import cvxpy as cp
+import numpy as np
+
+from ..errors import (DimensionError, InfeasibleError, InputError, NonFiniteError,
+                      ParameterError, RateBoundNotBuiltError, SolverError)
+from ..lti.checks import as_statespace
+from ..lti.norms import hinfnorm
+from ..lti.plant import GeneralizedPlant, lft
+from ..lti.scaling import PlantScaling, scale_plant
+from . import lmi as _lmi
+from .hinfsyn import _fastest_pole, _undo_loop_shift, _without_d22
+from .result import HinfsynOptions
+
+__all__ = ["lpvsyn", "LpvsynResult", "ScheduledController", "RateBoundNotBuiltError"]
+
+#: default back-off of the reconstruction level above the LMI optimum (relative).  The
+#: explicit formulas at ``(1 + r) γ_lmi`` with ``(X, Y)`` scaled by ``sqrt(1 + r)`` have
+#: poles that grow like ``1/r``: on the mass-spring-damper of tests/test_lpv.py (m in
+#: [1, 4], 9 grid points, 33 check points; basis [1, m] | [1, m, 1/m]) the certified γ
+#: over γ_lmi and the controllers' fastest pole were, for r = 5e-4: 0.979 | 0.999 and
+#: 2.1e4 | 9.0e3 rad/s; 1e-2: 0.983 | 0.9995, 884 | 1.3e4; 2e-2: 0.988 | 1.005,
+#: 399 | 897; 5e-2: 1.003 | 1.021, 138 | 122; 0.15: 1.049 | 1.068, 42 | 34 (plant modes
+#: 0.5-1 rad/s; measured 2026-12-02).  2 % keeps every pole below 1e3 rad/s (a 1 kHz
+#: realization's Nyquist frequency is 3.1e3) for at most 0.5 % of γ; LPVTools' default
+#: accepts up to 15 % for the same purpose
+BACKOFF = 2e-2
+#: levels, relative to the reconstruction level, tried in turn where the projected
+#: inequalities fail at a parameter value between grid points (they are only imposed on
+#: the grid): a larger level only adds a negative term to them
+_ESCALATION = (1.0, 1.005, 1.01, 1.02, 1.05, 1.1, 1.2, 1.5, 2.0, 4.0)
+#: relative slack the coupling ``min eig(c² X(p) Y(p)) > 1`` must have before a
+#: controller is formed (below it ``I - XY`` is numerically singular)
+_COUPLING_RTOL = 1e-9
+#: relative excess of a certified frozen norm over ``(1 + backoff) γ_lmi`` reported in
+#: ``warnings`` (roundoff of hinfnorm, whose own tolerance is 1e-9)
+_CERT_RTOL = 1e-6
+#: relative tolerance on a parameter value outside the design interval (roundoff of a
+#: caller's linspace)
+_RANGE_RTOL = 1e-12
+
+
+# --------------------------------------------------------------------------- input
+def _finite_value(v, what: str) -> float:
+    if isinstance(v, bool) or not isinstance(v, numbers.Real):
+        raise InputError(f"{what} must be a real number, got {v!r}")
+    v = float(v)
+    if not np.isfinite(v):
+        raise NonFiniteError(f"{what} is not finite ({v!r})")
+    return v
+
+
+def _axes(grid) -> tuple[tuple[str, ...], tuple[np.ndarray, ...]]:
+    """Names and sorted, distinct, finite values of each parameter of a grid dict."""
+    if not isinstance(grid, dict) or not grid:
+        raise ParameterError("grid must be a non-empty dict {name: values}")
+    names, axes = [], []
+    for name, values in grid.items():
+        if not isinstance(name, str) or not name.isidentifier():
+            raise ParameterError(f"parameter names must be identifiers, got {name!r}")
+        try:
+            v = np.asarray(values, dtype=float).ravel()
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"grid[{name!r}] must be numeric: {exc}") from exc
+        if v.size == 0:
+            raise ParameterError(f"grid[{name!r}] is empty")
+        if not np.all(np.isfinite(v)):
+            raise NonFiniteError(f"grid[{name!r}] holds NaN or infinite values")
+        v = np.unique(v)
+        names.append(name)
+        axes.append(v)
+    return tuple(names), tuple(axes)
+
+
+class _TablePlant:
+    """A plant known on a rectangular grid, its state-space matrices interpolated
+    (multi)linearly in between (LPVTools' convention for gridded systems)."""
+
+    def __init__(self, axes, table: dict, shape):
+        import scipy.interpolate
+
+        self.shape = shape
+        # axes with one value take no part in the interpolation (scipy needs two)
+        self._live = [i for i, a in enumerate(axes) if a.size > 1]
+        n, m, q = shape
+        data = np.empty(tuple(a.size for a in axes) + (n + q, n + m))
+        for idx in itertools.product(*(range(a.size) for a in axes)):
+            sys = table[tuple(float(a[i]) for a, i in zip(axes, idx))]
+            data[idx] = np.block([[sys.A, sys.B], [sys.C, sys.D]])
+        data = data.reshape(tuple(axes[i].size for i in self._live) + data.shape[-2:])
+        self._interp = None if not self._live else scipy.interpolate.RegularGridInterpolator(
+            tuple(axes[i] for i in self._live), data, method="linear")
+        self._data = data
+
+    def __call__(self, *p):
+        n = self.shape[0]
+        if self._interp is None:
+            M = self._data
+        else:
+            M = self._interp(np.asarray([p[i] for i in self._live], dtype=float)[None, :])[0]
+        return control.ss(M[:n, :n], M[:n, n:], M[n:, :n], M[n:, n:])
+
+
+def _from_pairs(pairs, grid):
+    """``(plant callable, names, axes)`` from a list of ``(p, plant)``."""
+    pairs = list(pairs)
+    if not pairs:
+        raise ParameterError("the list of (p, plant) pairs is empty")
+    if grid is None:
+        names = None
+    elif isinstance(grid, str):
+        names = (grid,)
+    elif isinstance(grid, dict):
+        names = tuple(grid)
+    else:
+        names = tuple(grid)
+    table, shape = {}, None
+    for k, pair in enumerate(pairs):
+        try:
+            p, sys = pair
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"entry {k} of the plant list is not a pair (p, plant)") from exc
+        if isinstance(p, dict):
+            if names is None:
+                names = tuple(p)
+            p = [p[nm] for nm in names]
+        p = tuple(_finite_value(v, f"parameter value of entry {k}")
+                  for v in np.atleast_1d(np.asarray(p, dtype=object)))
+        sys = as_statespace(sys, f"plant {k}")
+        s = (sys.nstates, sys.ninputs, sys.noutputs)
+        if shape is not None and s != shape:
+            raise DimensionError(f"plant {k} has (states, inputs, outputs) = {s}, the first "
+                                 f"one {shape}")
+        shape = s
+        if p in table:
+            raise ParameterError(f"the parameter value {p} appears twice in the plant list")
+        table[p] = sys
+    if names is None:
+        names = ("p",) if len(next(iter(table))) == 1 else \
+            tuple(f"p{i + 1}" for i in range(len(next(iter(table)))))
+    if any(len(p) != len(names) for p in table):
+        raise DimensionError(f"every parameter value needs {len(names)} entries {names}")
+    axes = tuple(np.unique([p[i] for p in table]) for i in range(len(names)))
+    if len(table) != int(np.prod([a.size for a in axes])):
+        raise ParameterError("the plants' parameter values do not form a rectangular grid "
+                             f"({len(table)} values, axes of sizes {[a.size for a in axes]})")
+    return _TablePlant(axes, table, shape), names, axes
+
+
+def _default_basis(axes):
+    """``[1]`` and each parameter that takes more than one value on the grid."""
+    live = [i for i, a in enumerate(axes) if a.size > 1]
+    return lambda *p: [1.0] + [p[i] for i in live]
+
+
+def _basis_values(basis, p, nb: int | None) -> np.ndarray:
+    try:
+        f = np.asarray(basis(*p), dtype=float).ravel()
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"the basis at p = {p} did not return numbers: {exc}") from exc
+    if nb is not None and f.size != nb:
+        raise DimensionError(f"the basis returned {f.size} values at p = {p}, {nb} at the "
+                             "first grid point")
+    if f.size == 0:
+        raise DimensionError("the basis returned no values")
+    if not np.all(np.isfinite(f)):
+        raise NonFiniteError(f"the basis is not finite at p = {p}: {f}")
+    return f
+
+
+def _plant_at(plant, p, nmeas, ncon, shape=None) -> GeneralizedPlant:
+    sys = as_statespace(plant(*p), f"P{p}")
+    s = (sys.nstates, sys.ninputs, sys.noutputs)
+    if shape is not None and s != shape:
+        raise DimensionError(f"P{p} has (states, inputs, outputs) = {s}, the plant at the "
+                             f"first grid point {shape}")
+    return GeneralizedPlant.from_statespace(sys, nmeas, ncon)
+
+
+def _apply_scaling(G: GeneralizedPlant, sc: PlantScaling) -> GeneralizedPlant:
+    """``G`` (``D22 = 0``) under the scalings ``sc`` that :func:`scale_plant` chose for
+    another plant of the family: one set of coordinates for the whole grid, since
+    ``X_i``, ``Y_i`` are shared by every grid point."""
+    b = G.blocks()
+    T, Ti = sc.T, 1.0 / sc.T
+    Su, Sy, cw, cz = sc.Su, sc.Sy, sc.cw, sc.cz
+    return GeneralizedPlant.from_matrices(
+        Ti[:, None] * b["A"] * T[None, :], Ti[:, None] * b["B1"] * cw,
+        Ti[:, None] * b["B2"] * Su[None, :], b["C1"] * T[None, :] / cz,
+        Sy[:, None] * b["C2"] * T[None, :], b["D11"] * (cw / cz), b["D12"] * Su[None, :] / cz,
+        Sy[:, None] * b["D21"] * cw, np.zeros_like(b["D22"]))
+
+
+# --------------------------------------------------------------------------- controller
+@dataclass(frozen=True)
+class ScheduledController:
+    """A controller scheduled on a measured parameter, frozen-parameter (ν = 0) design.
+
+    ``K.at(m3=42.0)`` (or ``K.at(42.0)`` for one parameter) is the controller at that
+    value: the explicit formulas of
+    :func:`~lmi_suspension.synthesis.lmi.decoupled_controller` on ``P(p)`` with
+    ``X(p) = Σ f_i(p) X_i`` and ``Y(p) = Σ f_i(p) Y_i``.
+
+    Attributes
+    ----------
+    names : tuple of str
+        The scheduling parameters, in the order the plant and basis callables take them.
+    bounds : tuple of (float, float)
+        Each parameter's design interval; ``at`` outside it is a :class:`ParameterError`.
+    basis : callable
+        ``f(*p) -> sequence of float``.
+    X, Y : tuple of numpy.ndarray
+        ``X_i``, ``Y_i``: the ``R`` and ``S`` of the projected LMIs of :mod:`.lmi`, in the
+        coordinates of the scaled plant (``scaling``, shared by the whole grid).
+    gamma_lmi_scaled : float
+        The LMI optimum in scaled units.
+    backoff : float
+        The reconstruction level is ``(1 + backoff) γ_lmi``.
+    scaling : PlantScaling
+        Scalings of states, controls, measurements and errors common to the grid.
+    plant : callable
+        ``P(*p) -> StateSpace`` (the caller's, or the interpolated table).
+    nmeas, ncon : int
+    """
+
+    names: tuple
+    bounds: tuple
+    basis: Callable
+    X: tuple
+    Y: tuple
+    gamma_lmi_scaled: float
+    backoff: float
+    scaling: PlantScaling
+    plant: Callable
+    nmeas: int
+    ncon: int
+    shape: tuple = field(repr=False, default=None)
+
+    def values(self, *args, **named) -> tuple:
+        """The parameter values as a tuple in the order of ``names`` (checked)."""
+        if args and named:
+            raise ParameterError("give the parameter values by position or by name, not both")
+        if named:
+            if set(named) != set(self.names):
+                raise ParameterError(f"expected values of {self.names}, got {tuple(named)}")
+            args = tuple(named[n] for n in self.names)
+        if len(args) != len(self.names):
+            raise ParameterError(f"expected {len(self.names)} values {self.names}, got "
+                                 f"{len(args)}")
+        p = tuple(_finite_value(v, f"parameter {n}") for n, v in zip(self.names, args))
+        for n, v, (lo, hi) in zip(self.names, p, self.bounds):
+            tol = _RANGE_RTOL * max(1.0, abs(lo), abs(hi))
+            if not lo - tol <= v <= hi + tol:
+                raise ParameterError(f"{n} = {v:g} is outside the design interval "
+                                     f"[{lo:g}, {hi:g}]")
+        return p
+
+    def lyapunov(self, *args, **named) -> tuple[np.ndarray, np.ndarray]:
+        """``(X(p), Y(p))`` of the scaled plant."""
+        p = self.values(*args, **named)
+        f = _basis_values(self.basis, p, len(self.X))
+        return (sum(fi * Xi for fi, Xi in zip(f, self.X)),
+                sum(fi * Yi for fi, Yi in zip(f, self.Y)))
+
+    def build(self, *args, **named) -> tuple[control.StateSpace, float, float]:
+        """``(K, level, cond_xy)``: the controller at ``p``, the level (plant units) it was
+        formed at, and the condition number of ``I - X(p)Y(p)`` in the balanced frame.
+
+        The level is ``(1 + backoff) γ_lmi`` wherever the projected inequalities hold
+        there (on the grid, by construction); between grid points, where they fail, the
+        next of ``_ESCALATION`` times it (said by the returned level)."""
+        p = self.values(*args, **named)
+        X, Y = self.lyapunov(*p)
+        G = _plant_at(self.plant, p, self.nmeas, self.ncon, self.shape)
+        Ps = _apply_scaling(_without_d22(G), self.scaling)
+        g0 = self.gamma_lmi_scaled * (1.0 + self.backoff)
+        # the smallest eigenvalue of X(p)Y(p): the coupling [[X, I], [I, Y]] > 0 holds
+        # iff it exceeds 1 (imposed on the grid only; between grid points of a rich
+        # basis it fell to 0.985 on the mass-spring-damper of tests/test_lpv.py)
+        # (with X(p) > 0; an indefinite X(p) fails at every level)
+        definite = np.linalg.eigvalsh(_lmi._sym(X))[0] > 0.0
+        lam = float(np.min(np.linalg.eigvals(X @ Y).real)) if definite else -np.inf
+        last = None
+        for k in _ESCALATION:
+            level = g0 * k
+            # (c X, c Y) with c = sqrt(level / γ_lmi) keeps the projected inequalities
+            # wherever (X, Y) satisfy them at γ_lmi (see hinfsyn's _explicit) and gives
+            # the coupling c² - 1 of relative slack
+            c2 = level / self.gamma_lmi_scaled
+            if not c2 * lam > 1.0 + _COUPLING_RTOL:
+                last = f"coupling: min eig(X(p) Y(p)) = {lam:.6g} against 1/{c2:.6g}"
+                continue
+            c = float(np.sqrt(c2))
+            try:
+                Ks, cond_xy = _lmi.decoupled_controller(Ps, c * X, c * Y, level)
+            except (SolverError, np.linalg.LinAlgError) as exc:
+                last = exc
+                continue
+            K = _undo_loop_shift(self.scaling.controller_to_original(Ks), G.D22)
+            return K, level / self.scaling.gamma_factor, float(cond_xy)
+        raise SolverError(f"no controller at p = {p}: the projected inequalities fail up "
+                          f"to {_ESCALATION[-1]:g} times the level ({last})")
+
+    def at(self, *args, **named) -> control.StateSpace:
+        """The controller at one parameter value (``K.at(m3=42.0)``)."""
+        return self.build(*args, **named)[0]
+
+
+# --------------------------------------------------------------------------- result
+@dataclass(frozen=True)
+class LpvsynResult:
+    """Result of :func:`lpvsyn`.
+
+    Attributes
+    ----------
+    K : ScheduledController
+    gamma : float
+        The certified value: the largest ``hinfnorm(lft(P(p), K(p)))`` over
+        ``check_grid`` (``inf`` where a frozen loop is unstable).
+    gamma_lmi : float
+        The LMI optimum (plant units): the lowest level at which one pair ``X(p)``,
+        ``Y(p)`` of this basis satisfies the LMIs at every grid point, i.e. a lower bound
+        on what these Lyapunov certificates can prove, not on the frozen norms: those are
+        exact per point and may be lower (0.979 γ_lmi with basis [1, m] on the example of
+        tests/test_lpv.py, and 0.84 with basis [1]; measured 2026-12-02).  A frozen norm
+        above ``(1 + backoff) γ_lmi`` (the level the controllers are formed at) is
+        reported in ``warnings``.
+    grid, check_grid : dict
+        The design grid and the denser grid (each interval cut in ``check_density``
+        pieces, the ends included) on which ``gamma`` is certified.
+    gamma_check : numpy.ndarray
+        The certified norm at each point of the check grid (in the order of
+        :func:`itertools.product` over ``check_grid``'s values).
+    levels : numpy.ndarray
+        The level each of those controllers was formed at (``(1 + backoff) γ_lmi``, or
+        above it between grid points where the grid's LMIs do not hold there).
+    warnings : tuple of str
+        What the certificate found wrong (a frozen loop unstable, a norm above
+        ``(1 + backoff) γ_lmi``, a controller that could not be formed) and Clarabel's
+        recoveries; empty when everything certified.
+    notes : tuple of str
+        Information that does not weaken the certificate: check points between grid
+        points where the grid's LMIs do not hold at the level and the controller was
+        formed at a higher one (its norm certified all the same).
+    seconds, seconds_lmi, seconds_check : float
+        Wall time in all, in the γ minimisation and in the check.
+    """
+
+    K: ScheduledController
+    gamma: float
+    gamma_lmi: float
+    grid: dict
+    check_grid: dict
+    gamma_check: np.ndarray
+    levels: np.ndarray
+    warnings: tuple
+    notes: tuple
+    seconds: float
+    seconds_lmi: float
+    seconds_check: float
+    status: str = ""
+
+    def gamma_frozen(self, *args, **named) -> float:
+        """``hinfnorm(lft(P(p), K(p)))`` at one parameter value (``inf`` if unstable)."""
+        p = self.K.values(*args, **named)
+        G = _plant_at(self.K.plant, p, self.K.nmeas, self.K.ncon, self.K.shape)
+        return float(hinfnorm(lft(G, self.K.at(*p)))[0])
+
+
+# --------------------------------------------------------------------------- synthesis
+def _gamma_lmi(plants, F, opts: HinfsynOptions, warnings: list):
+    """The γ minimisation over the grid (scaled plants, ``D22 = 0``)."""
+    n, nb = plants[0].nstates, F.shape[1]
+    Xs = [cp.Variable((n, n), symmetric=True) for _ in range(nb)]
+    Ys = [cp.Variable((n, n), symmetric=True) for _ in range(nb)]
+    g = cp.Variable(nonneg=True)
+    eye = np.eye(n)
+    cons = []
+    for Pk, f in zip(plants, F):
+        X = sum(float(fi) * Xi for fi, Xi in zip(f, Xs))
+        Y = sum(float(fi) * Yi for fi, Yi in zip(f, Ys))
+        pr, ps = _lmi._projections(Pk, Pk, sparse=False)
+        cons += [p.lmi(V, g, opts.margin) for p, V in ((pr, X), (ps, Y)) if p is not None]
+        cons += [_lmi._sym(cp.bmat([[X, eye], [eye, Y]])) >> 0,
+                 cp.trace(X) + cp.trace(Y) <= opts.xy_bound * n]
+    prob = cp.Problem(cp.Minimize(g), cons)
+    status, _ = _lmi._solve(prob, opts, "lpvsyn gamma minimisation", warnings)
+    if status in _lmi._INFEASIBLE:
+        raise InfeasibleError("the gridded H∞ LMIs are infeasible for every γ: no "
+                              "scheduled controller with this basis stabilises every "
+                              "frozen plant within the trace bound")
+    return (float(g.value), tuple(_lmi._sym(V.value) for V in Xs),
+            tuple(_lmi._sym(V.value) for V in Ys), str(status))
+
+
+def _check_axes(axes, density: int):
+    out = []
+    for a in axes:
+        if a.size == 1:
+            out.append(a.copy())
+            continue
+        pts = [np.linspace(lo, hi, density + 1)[:-1] for lo, hi in zip(a[:-1], a[1:])]
+        out.append(np.r_[np.concatenate(pts), a[-1]])
+    return out
+
+
+def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
+           rate: dict | None = None, backoff: float = BACKOFF, check_density: int = 4,
+           options: HinfsynOptions | None = None) -> LpvsynResult:
+    """Gain-scheduled H∞ output-feedback synthesis on a parameter grid, parameters frozen
+    during operation (rate bound ν = 0).
+
+    Parameters
+    ----------
+    P : callable or list of (p, plant)
+        ``P(*p) -> control.StateSpace`` (the parameters positionally, in the order of
+        ``grid``), continuous time, the same sizes at every ``p``; or a list of pairs
+        ``(p, plant)`` on a rectangular grid (``p`` a number, a tuple, or a dict by
+        name), interpolated linearly between grid points.
+    grid : dict or str or sequence of str
+        ``{name: values}``: the design grid is the Cartesian product of the values.  With
+        a list of plants, the parameter names (a dict's values are then not used).
+    nmeas, ncon : int
+        Numbers of measurements and controls (last outputs, last inputs).
+    basis : callable, optional
+        ``f(*p) -> sequence`` of the basis functions of ``X(p)`` and ``Y(p)``; the
+        default is ``[1]`` and each parameter with more than one grid value.
+    rate : dict, optional
+        ``{name: ν}``, the bound on ``|dp/dt|``; only 0 (the default) is built.
+    backoff : float
+        The controller is formed at ``(1 + backoff) γ_lmi`` (see ``BACKOFF``).
+    check_density : int
+        Each design interval is cut into this many pieces for the certificate (>= 1;
+        the default 4 is what the certificate of issue 61 asks for).
+    options : HinfsynOptions, optional
+        Clarabel tolerances, ``margin``, ``xy_bound``, ``max_recoveries``, ``cert_rtol``.
+
+    Returns
+    -------
+    LpvsynResult
+
+    Raises
+    ------
+    RateBoundNotBuiltError
+        A nonzero rate bound (ν > 0 is not built yet).
+    NonFiniteError, DimensionError, DiscreteTimeError, ParameterError, InputError
+        Bad grid, plant or basis: NaN, an empty grid, discrete-time plants, sizes that
+        change across the grid, a basis of the wrong length, non-finite, or linearly
+        dependent on the grid.
+    InfeasibleError, SolverError
+        No scheduled controller exists for this basis, or Clarabel failed.
+
+    Notes
+    -----
+    The controller is guaranteed for frozen parameters only: for each constant ``p``
+    the loop ``F_l(P(p), K(p))`` is stable with its norm below the level, certified on
+    the check grid; a parameter that varies during operation, however slowly, is not
+    covered (that needs the ``∂X/∂p`` terms of a rate bound ν > 0).  Between check
+    points nothing is certified.
+
+    Examples
+    --------
+    A mass-spring-damper whose measured mass ``m`` is in [1, 4]; the control force acts
+    through ``1/m``:
+
+    >>> import control, numpy as np
+    >>> def msd(m):      # w = [force, noise], u; z = [x, 0.1 u]; y = x + 0.1 noise
+    ...     return control.ss([[0, 1], [-1 / m, -0.2 / m]], [[0, 0, 0], [1 / m, 0, 1 / m]],
+    ...                       [[1, 0], [0, 0], [1, 0]], [[0, 0, 0], [0, 0, 0.1], [0, 0.1, 0]])
+    >>> res = lpvsyn(msd, {"m": np.linspace(1.0, 4.0, 5)}, 1, 1)
+    >>> res.K.at(m=2.2).nstates, len(res.check_grid["m"]), res.warnings
+    (2, 17, ())
+    >>> K, level, _ = res.K.build(m=2.2)          # between grid points
+    >>> bool(res.gamma_frozen(m=2.2) <= level * (1 + 1e-6))
+    True
+    >>> bool(res.gamma <= res.gamma_lmi * (1 + res.K.backoff) * (1 + 1e-6))
+    True
+    """
+    t0 = time.perf_counter()
+    opts = HinfsynOptions() if options is None else options
+    if not isinstance(opts, HinfsynOptions):
+        raise ParameterError("options must be a HinfsynOptions instance")
+    if isinstance(check_density, bool) or not isinstance(check_density, (int, np.integer)) \
+            or check_density < 1:
+        raise ParameterError(f"check_density must be a positive integer, got {check_density!r}")
+    backoff = _finite_value(backoff, "backoff")
+    if backoff <= 0:
+        raise ParameterError(f"backoff must be positive, got {backoff!r}")
+    if callable(P) and not isinstance(P, (control.StateSpace, GeneralizedPlant)):
+        names, axes = _axes(grid)
+        plant = P
+    elif isinstance(P, (list, tuple)):
+        plant, names, axes = _from_pairs(P, grid)
+    else:
+        raise InputError("P must be a callable p -> StateSpace or a list of (p, plant)")
+    rate = {} if rate is None else rate
+    if not isinstance(rate, dict) or set(rate) - set(names):
+        raise ParameterError(f"rate must be a dict over the parameters {names}, got {rate!r}")
+    for name, nu in rate.items():
+        nu = _finite_value(nu, f"rate[{name!r}]")
+        if nu < 0:
+            raise ParameterError(f"rate[{name!r}] must be >= 0, got {nu}")
+        if nu > 0:
+            raise RateBoundNotBuiltError(
+                f"rate[{name!r}] = {nu:g}: rate-bounded (ν > 0) LPV synthesis is not built "
+                "yet; only frozen parameters (ν = 0) are")
+    basis = _default_basis(axes) if basis is None else basis
+    if not callable(basis):
+        raise InputError("basis must be a callable f(*p) -> sequence of float")
+    points = list(itertools.product(*(a.tolist() for a in axes)))
+    nb = _basis_values(basis, points[0], None).size
+    F = np.vstack([_basis_values(basis, p, nb) for p in points])
+    if np.linalg.matrix_rank(F) < nb:
+        raise ParameterError(f"the {nb} basis functions are linearly dependent on the grid "
+                             f"(rank {np.linalg.matrix_rank(F)} over {len(points)} points): "
+                             "X(p), Y(p) would not be unique; drop a function or refine "
+                             "the grid")
+    first = _plant_at(plant, points[0], nmeas, ncon)
+    shape = (first.nstates, first.sys.ninputs, first.sys.noutputs)
+    if not first.nstates:
+        raise DimensionError("the plant has no states: a static problem; use hinfsyn at "
+                             "each parameter value")
+    Gs = [first] + [_plant_at(plant, p, nmeas, ncon, shape) for p in points[1:]]
+    # one scaling for the whole grid (X_i, Y_i are shared): the one of the middle point
+    mid = _without_d22(Gs[len(Gs) // 2])
+    if opts.scale:
+        _, sc = scale_plant(mid)
+    else:
+        sc = PlantScaling(np.ones(mid.nstates), np.ones(mid.nu), np.ones(mid.ny), 1.0, 1.0)
+    plants = [_apply_scaling(_without_d22(G), sc) for G in Gs]
+    warnings: list[str] = []
+    t1 = time.perf_counter()
+    g_s, Xi, Yi, status = _gamma_lmi(plants, F, opts, warnings)
+    t_lmi = time.perf_counter() - t1
+    K = ScheduledController(tuple(names), tuple((float(a[0]), float(a[-1])) for a in axes),
+                            basis, Xi, Yi, g_s, backoff, sc, plant, int(nmeas), int(ncon),
+                            shape)
+    gamma_lmi = g_s / sc.gamma_factor
+    t2 = time.perf_counter()
+    check = _check_axes(axes, int(check_density))
+    level0 = gamma_lmi * (1.0 + backoff)
+    norms, levels, escalated = [], [], []
+    for p in itertools.product(*(a.tolist() for a in check)):
+        where = ", ".join(f"{n}={v:.6g}" for n, v in zip(names, p))
+        try:
+            Kp, level, _cond = K.build(*p)
+        except SolverError as exc:
+            warnings.append(f"at {where}: {exc}")
+            norms.append(np.inf)
+            levels.append(np.inf)
+            continue
+        if level > level0 * (1.0 + 1e-12):
+            escalated.append(where)
+        G = _plant_at(plant, p, nmeas, ncon, shape)
+        gam = float(hinfnorm(lft(G, Kp))[0])
+        norms.append(gam)
+        levels.append(level)
+        if not np.isfinite(gam):
+            warnings.append(f"at {where}: the frozen closed loop is NOT stable")
+        elif gam > level0 * (1.0 + _CERT_RTOL):
+            warnings.append(f"at {where}: certified {gam:.6g} exceeds the LMI's level "
+                            f"(1 + backoff) γ_lmi = {level0:.6g} by "
+                            f"{100 * (gam / level0 - 1):.3g} %")
+    notes = []
+    if escalated:
+        notes.append(f"at {len(escalated)} of {len(norms)} check points ({escalated[0]}, "
+                        f"...) the grid's LMIs do not hold at the level {level0:.6g}; the "
+                        f"controllers there are formed at up to {max(levels):.6g} "
+                        "(certified as everywhere)")
+    norms = np.asarray(norms)
+    t3 = time.perf_counter()
+    return LpvsynResult(K=K, gamma=float(np.max(norms)), gamma_lmi=float(gamma_lmi),
+                        grid=dict(zip(names, axes)), check_grid=dict(zip(names, check)),
+                        gamma_check=norms, levels=np.asarray(levels),
+                        warnings=tuple(warnings), notes=tuple(notes), seconds=t3 - t0,
+                        seconds_lmi=t_lmi, seconds_check=t3 - t2, status=status)
