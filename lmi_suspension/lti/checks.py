@@ -10,8 +10,8 @@ import numpy as np
 from ..errors import (DimensionError, DiscreteTimeError, InputError, NonFiniteError,
                       ParameterError)
 
-__all__ = ["as_finite_array", "as_statespace", "positive_scalar", "require_continuous",
-           "require_finite_system"]
+__all__ = ["as_finite_array", "as_statespace", "finite_scalar", "positive_scalar",
+           "require_continuous", "require_finite_system"]
 
 
 def as_finite_array(value, name: str, *, ndim: int | None = None, dtype=float) -> np.ndarray:
@@ -87,6 +87,23 @@ def as_statespace(sys, name: str = "system") -> control.StateSpace:
     return ss
 
 
+def finite_scalar(value, name: str) -> float:
+    """``value`` as a finite float, or a typed error naming ``name`` (a bool or a
+    non-real is a :class:`ParameterError`, NaN or infinity a :class:`NonFiniteError`).
+
+    Examples
+    --------
+    >>> finite_scalar(-2, "kp")
+    -2.0
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ParameterError(f"{name} must be a real number, got {value!r}")
+    value = float(value)
+    if not np.isfinite(value):
+        raise NonFiniteError(f"{name} must be finite, got {value!r}")
+    return value
+
+
 def positive_scalar(value, name: str) -> float:
     """``value`` as a positive finite float, or a typed error naming ``name``.
 
@@ -95,11 +112,7 @@ def positive_scalar(value, name: str) -> float:
     >>> positive_scalar(2, "dt")
     2.0
     """
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ParameterError(f"{name} must be a real number, got {value!r}")
-    value = float(value)
-    if not np.isfinite(value):
-        raise NonFiniteError(f"{name} must be finite, got {value!r}")
+    value = finite_scalar(value, name)
     if value <= 0:
         raise ParameterError(f"{name} must be positive, got {value!r}")
     return value

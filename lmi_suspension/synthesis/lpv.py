@@ -42,7 +42,6 @@ IEEE Trans. Control Systems Technology 6(1) (1998) 21-32.
 from __future__ import annotations
 
 import itertools
-import numbers
 import time
 from dataclasses import dataclass, field
 from typing import Callable
@@ -53,12 +52,12 @@ import numpy as np
 
 from ..errors import (DimensionError, InfeasibleError, InputError, NonFiniteError,
                       ParameterError, RateBoundNotBuiltError, SolverError)
-from ..lti.checks import as_statespace
+from ..lti.checks import as_statespace, finite_scalar
 from ..lti.norms import hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
 from ..lti.scaling import PlantScaling, scale_plant
 from . import lmi as _lmi
-from .hinfsyn import _fastest_pole, _undo_loop_shift, _without_d22
+from .hinfsyn import _undo_loop_shift, _without_d22
 from .result import HinfsynOptions
 
 __all__ = ["lpvsyn", "LpvsynResult", "ScheduledController", "RateBoundNotBuiltError"]
@@ -90,13 +89,6 @@ _RANGE_RTOL = 1e-12
 
 
 # --------------------------------------------------------------------------- input
-def _finite_value(v, what: str) -> float:
-    if isinstance(v, bool) or not isinstance(v, numbers.Real):
-        raise InputError(f"{what} must be a real number, got {v!r}")
-    v = float(v)
-    if not np.isfinite(v):
-        raise NonFiniteError(f"{what} is not finite ({v!r})")
-    return v
 
 
 def _axes(grid) -> tuple[tuple[str, ...], tuple[np.ndarray, ...]]:
@@ -173,7 +165,7 @@ def _from_pairs(pairs, grid):
             if names is None:
                 names = tuple(p)
             p = [p[nm] for nm in names]
-        p = tuple(_finite_value(v, f"parameter value of entry {k}")
+        p = tuple(finite_scalar(v, f"parameter value of entry {k}")
                   for v in np.atleast_1d(np.asarray(p, dtype=object)))
         sys = as_statespace(sys, f"plant {k}")
         s = (sys.nstates, sys.ninputs, sys.noutputs)
@@ -296,7 +288,7 @@ class ScheduledController:
         if len(args) != len(self.names):
             raise ParameterError(f"expected {len(self.names)} values {self.names}, got "
                                  f"{len(args)}")
-        p = tuple(_finite_value(v, f"parameter {n}") for n, v in zip(self.names, args))
+        p = tuple(finite_scalar(v, f"parameter {n}") for n, v in zip(self.names, args))
         for n, v, (lo, hi) in zip(self.names, p, self.bounds):
             tol = _RANGE_RTOL * max(1.0, abs(lo), abs(hi))
             if not lo - tol <= v <= hi + tol:
@@ -532,7 +524,7 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
     if isinstance(check_density, bool) or not isinstance(check_density, (int, np.integer)) \
             or check_density < 1:
         raise ParameterError(f"check_density must be a positive integer, got {check_density!r}")
-    backoff = _finite_value(backoff, "backoff")
+    backoff = finite_scalar(backoff, "backoff")
     if backoff <= 0:
         raise ParameterError(f"backoff must be positive, got {backoff!r}")
     if callable(P) and not isinstance(P, (control.StateSpace, GeneralizedPlant)):
@@ -546,7 +538,7 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
     if not isinstance(rate, dict) or set(rate) - set(names):
         raise ParameterError(f"rate must be a dict over the parameters {names}, got {rate!r}")
     for name, nu in rate.items():
-        nu = _finite_value(nu, f"rate[{name!r}]")
+        nu = finite_scalar(nu, f"rate[{name!r}]")
         if nu < 0:
             raise ParameterError(f"rate[{name!r}] must be >= 0, got {nu}")
         if nu > 0:

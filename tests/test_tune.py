@@ -1,0 +1,542 @@
+"""Tests of lmi_suspension.tune: tunable blocks and hinfstruct.
+
+Reference values, each computed here by a route hinfstruct does not use:
+
+* central finite differences of ``hinfnorm`` for the subgradient and of
+  ``control.evalfr`` for the blocks' frequency-response derivatives;
+* brute-force grids of ``hinfnorm(lft(P, K))`` over the PI and PID parameters, refined
+  around their best cells (``_grid_min``: the grid and its final spacing are stated at
+  each use);
+* the closed-form optimal static gain of a first-order loop (derived below);
+* for full-order blocks: the closed-form DGKF optimum of a scalar plant (Doyle, Glover,
+  Khargonekar & Francis, IEEE TAC 34, 1989; as in tests/test_hinfsyn.py) and a γ
+  bisection over SLICOT ``sb10ad``'s suboptimal controllers (slycot, job 4), with
+  ``hinfsyn``'s certified γ beside them.
+"""
+
+import importlib
+import itertools
+import time
+
+import control
+import numpy as np
+import pytest
+import scipy.optimize
+
+from lmi_suspension import hinfnorm, hinfsyn, lft
+from lmi_suspension.errors import (DimensionError, DiscreteTimeError, IterationLimitError,
+                                   NonFiniteError, ParameterError)
+from lmi_suspension.lti import GeneralizedPlant
+from lmi_suspension.tune import (HinfstructOptions, HinfstructResult, block_diagonal,
+                                 hinfstruct, tunable_gain, tunable_pid, tunable_ss)
+
+# the module, not the function of the same name that lmi_suspension.tune exports
+hs = importlib.import_module("lmi_suspension.tune.hinfstruct")
+
+s = control.tf("s")
+
+
+# --------------------------------------------------------------------------- plants
+def mixed_sensitivity(G, W1, W2) -> control.StateSpace:
+    """Inputs ``[r, u]``, outputs ``[W1 e, W2 u, e]`` with ``e = r - G u`` (SISO)."""
+    G, W1, W2 = (control.ss(x) for x in (G, W1, W2))
+
+    def mats(T):
+        n = T.nstates
+        return (np.asarray(T.A, float).reshape(n, n), np.asarray(T.B, float).reshape(n, 1),
+                np.asarray(T.C, float).reshape(1, n), float(np.asarray(T.D).ravel()[0]))
+
+    (Ag, Bg, Cg, Dg), (A1, B1, C1, D1), (A2, B2, C2, D2) = mats(G), mats(W1), mats(W2)
+    ng, n1, n2 = G.nstates, W1.nstates, W2.nstates
+    n = ng + n1 + n2
+    g, a, b = slice(0, ng), slice(ng, ng + n1), slice(ng + n1, n)
+    A, B, C, D = np.zeros((n, n)), np.zeros((n, 2)), np.zeros((3, n)), np.zeros((3, 2))
+    A[g, g], B[g, 1:] = Ag, Bg
+    A[a, a], A[a, g], B[a, :1], B[a, 1:] = A1, -B1 @ Cg, B1, -B1 * Dg
+    A[b, b], B[b, 1:] = A2, B2
+    C[0, a], C[0, g], D[0] = C1, -D1 * Cg, [D1, -D1 * Dg]
+    C[1, b], D[1, 1] = C2, D2
+    C[2, g], D[2] = -Cg, [1.0, -Dg]
+    return control.ss(A, B, C, D)
+
+
+def plant_a():
+    """First order, performance weight with a near-integrator, constant control weight
+    (2 states)."""
+    return mixed_sensitivity(1 / (s + 1), (0.5 * s + 1) / (s + 1e-3), control.tf([0.1], [1]))
+
+
+def plant_b():
+    """Lightly damped second order, a control weight rising to 100 (4 states)."""
+    return mixed_sensitivity(4 / (s**2 + 0.8 * s + 4), (0.5 * s + 0.8) / (s + 8e-4),
+                             (s + 2) / (0.01 * s + 20))
+
+
+def plant_d():
+    """A 0.3 s delay (first-order Padé) and a lag (3 states)."""
+    return mixed_sensitivity((1 - 0.15 * s) / ((1 + 0.15 * s) * (s + 1)),
+                             (0.5 * s + 0.3) / (s + 3e-4), control.tf([0.2], [1]))
+
+
+def plant_unstable():
+    """An unstable pole at 1 rad/s and a lag (4 states)."""
+    return mixed_sensitivity(2 / ((s - 1) * (0.2 * s + 1)), (0.5 * s + 1) / (s + 1e-3),
+                             (s + 1) / (0.05 * s + 10))
+
+
+def plant_biproper():
+    """A biproper plant (D22 = -1/2: the loop's (I - K P22)⁻¹ is not I) (3 states)."""
+    return mixed_sensitivity((s + 3) / (2 * s + 1), (0.5 * s + 1) / (s + 1e-3),
+                             (s + 1) / (0.05 * s + 10))
+
+
+def plant_two_inputs():
+    """A lightly damped mass (poles -0.2 ± 2j) with a force disturbance and sensor noise:
+    two disturbances, so the top singular vectors are complex vectors (2 states)."""
+    A = np.array([[0.0, 1.0], [-4.0, -0.4]])
+    B = np.array([[0.0, 0.0, 0.0], [1.0, 0.0, 1.0]])
+    C = np.array([[1.0, 0.0], [0.0, 0.0], [1.0, 0.0]])
+    D = np.array([[0.0, 0.0, 0.0], [0.0, 0.0, 0.3], [0.0, 0.2, 0.0]])
+    return control.ss(A, B, C, D)
+
+
+def pi_ss(kp, ki):
+    return control.ss([[0.0]], [[1.0]], [[ki]], [[kp]])
+
+
+def pid_ss(kp, ki, kd, tf):
+    # kp + ki/s + kd s/(tf s + 1) = (kp + kd/tf) + ki/s - (kd/tf²)/(s + 1/tf), written out
+    # here (unit input gains) rather than taken from tunable_pid
+    return control.ss([[0.0, 0.0], [0.0, -1.0 / tf]], [[1.0], [1.0]],
+                      [[ki, -kd / tf**2]], [[kp + kd / tf]])
+
+
+def _grid_min(P, make_K, boxes, n, *, refine=3, nref=7, keep=3):
+    """Brute force: a grid of ``n[i]`` points on each ``boxes[i]``, then ``refine``
+    rounds, each a grid of ``nref`` points per axis spanning ±1 spacing of the last round
+    around each of its ``keep`` best points (keeping several: a PI's optimum sits in a
+    narrow valley where a resonant peak meets the high-frequency asymptote, and the best
+    coarse cell need not be the one that holds it).  Returns ``(gamma, point, spacing)``."""
+    axes = [np.linspace(lo, hi, k) for (lo, hi), k in zip(boxes, n)]
+    spacing = np.array([x[1] - x[0] for x in axes])
+    points = list(itertools.product(*axes))
+    best = (np.inf, None)
+    for r in range(refine + 1):
+        values = [hinfnorm(lft(P, make_K(*p)))[0] for p in points]
+        k = int(np.argmin(values))
+        if values[k] < best[0]:
+            best = (values[k], points[k])
+        if r == refine:
+            break
+        centres = [np.array(points[i]) for i in np.argsort(values)[:keep]]
+        points = [p for c in centres for p in itertools.product(
+            *[np.linspace(ci - h, ci + h, nref) for ci, h in zip(c, spacing)])]
+        spacing = spacing * 2 / (nref - 1)
+    return best[0], best[1], spacing
+
+
+# --------------------------------------------------------------------------- blocks
+@pytest.mark.parametrize("block, theta", [
+    (tunable_gain("K", 2, 3), np.arange(6.0) - 2.5),
+    (tunable_pid("C", "PI"), [0.7, 1.3]),
+    (tunable_pid("C", "PD"), [0.7, 0.4, 0.05]),
+    (tunable_pid("C", "PID", tf=0.1), [0.7, 1.3, 0.4]),
+    (tunable_pid("C", "PID"), [0.7, 1.3, 0.4, 0.05]),
+    (tunable_ss("C", 3, 2, 1), np.linspace(-1.5, 1.2, 15)),
+    (block_diagonal([tunable_pid("C1", "PI"), tunable_ss("C2", 2, 1, 2)]),
+     np.linspace(-1.0, 1.0, 13)),
+])
+def test_block_frequency_derivative_matches_central_differences(block, theta):
+    theta = np.asarray(theta, dtype=float)
+    assert block.n_params == theta.size == len(block.param_names)
+    pt = 0.3 + 2.0j
+    dK = block.freqresp_derivative(theta, pt)
+    assert dK.shape == (block.n_params, block.noutputs, block.ninputs)
+    for i in range(block.n_params):
+        h = 1e-6 * max(1.0, abs(theta[i]))
+        e = np.zeros_like(theta)
+        e[i] = h
+        fd = (np.asarray(control.evalfr(block.ss(theta + e), pt))
+              - np.asarray(control.evalfr(block.ss(theta - e), pt))).reshape(dK[i].shape) / (2 * h)
+        np.testing.assert_allclose(dK[i], fd, rtol=1e-6, atol=1e-8)
+    # at s = inf the derivative is that of D
+    np.testing.assert_allclose(block.freqresp_derivative(theta, np.inf),
+                               block.jacobian(theta)[:, :block.noutputs, :block.ninputs])
+
+
+def test_pid_block_is_the_textbook_pid():
+    C = tunable_pid("C", "PID")
+    assert C.param_names == ("C.kp", "C.ki", "C.kd", "C.tf")
+    theta = [2.0, 3.0, 0.5, 0.1]
+    for w in (0.1, 1.0, 30.0):
+        want = complex(control.evalfr(pid_ss(*theta), 1j * w))
+        assert complex(control.evalfr(C.ss(theta), 1j * w)) == pytest.approx(want, rel=1e-12)
+    assert C.values(theta) == {"C.kp": 2.0, "C.ki": 3.0, "C.kd": 0.5, "C.tf": 0.1}
+
+
+def test_state_space_block_reaches_real_and_complex_pairs():
+    K = tunable_ss("K", 2, 1, 1)
+    theta = K.start
+    theta[:3] = [-1.0, 0.0, -5.0]                 # two real poles, b = 0
+    assert sorted(np.real(K.ss(theta).poles())) == pytest.approx([-5.0, -1.0])
+    theta[:3] = [-3.0, 2.0, -3.0]                 # -3 ± 2j
+    assert sorted(K.ss(theta).poles().tolist(), key=np.imag) == pytest.approx([-3 - 2j, -3 + 2j])
+
+
+# --------------------------------------------------------------------------- gradient
+@pytest.mark.parametrize("plant, block, theta", [
+    (plant_b, tunable_pid("C", "PI"), [0.05, 0.5]),                 # peak at ω = inf
+    (plant_d, tunable_pid("C", "PID"), [0.5, 0.5, 0.05, 0.05]),     # at 0.043 rad/s
+    (plant_unstable, tunable_pid("C", "PID", tf=0.05), [1.0, 0.25, -0.05]),  # 0.63 rad/s
+    (plant_a, tunable_ss("C", 2, 1, 1), [-0.5, 0.3, -2.0, 1.0, 0.5, 0.4, -0.3, 0.2]),  # ω = 0
+    (plant_biproper, tunable_pid("C", "PI"), [0.2, 0.2]),            # D22 ≠ 0, ω = inf
+    (plant_biproper, tunable_ss("C", 1, 1, 1), [-1.0, 1.0, 1.0, 0.2]),  # D22 ≠ 0, ω = 0
+    (plant_two_inputs, tunable_pid("C", "PID", tf=0.1), [-1.0, -0.5, -0.5]),  # 2.2 rad/s
+    (plant_two_inputs, tunable_ss("C", 2, 1, 1), [-1.0, 2.0, -3.0, 1.0, 1.0, -0.5, -0.3, 0.0]),
+])
+def test_subgradient_matches_central_differences(plant, block, theta):
+    """At a point where σ̄ peaks once (checked), f is differentiable and the LFT
+    derivative ``dT = P12 (I - K P22)⁻¹ dK (I - P22 K)⁻¹ P21`` in the project's ``lft``
+    convention must give its gradient: at a finite peak, at ω = 0 and at ω = inf, with
+    D22 ≠ 0 (the two inverses differ from I) and with two disturbances (complex singular
+    vectors); those cases fail when the sign of ``K P22`` or a conjugate is wrong.
+    Measured agreement 2026-12-02: 2e-12 to 3.3e-6 relative to the largest component."""
+    from lmi_suspension.lti.norms import sigma_max
+    P = plant()
+    loop = hs._Loop(GeneralizedPlant.from_statespace(P, 1, 1), block)
+    theta = np.asarray(theta, dtype=float)
+    f, omega, K = loop.hinf(theta)
+    assert np.isfinite(f)
+    # one peak: every other local maximum of σ̄ is at least 1 % lower
+    w = np.logspace(-5, 5, 20001)
+    sig = sigma_max(lft(P, K), w)
+    tops = [i for i in range(w.size) if (i == 0 or sig[i] >= sig[i - 1])
+            and (i == w.size - 1 or sig[i] >= sig[i + 1])]
+    far = [sig[i] for i in tops if not (omega == 0 and i == 0 or np.isinf(omega) and
+                                        i == w.size - 1 or 0 < omega < np.inf and
+                                        abs(np.log(w[i] / omega)) < 0.05)]
+    if not np.isinf(omega):
+        far.append(sigma_max(lft(P, K), [np.inf])[0])
+    assert max(far) < 0.99 * f
+    g = loop.hinf_gradient(theta, omega)
+    fd = np.empty_like(g)
+    for i in range(theta.size):
+        h = 1e-6 * max(1.0, abs(theta[i]))
+        e = np.zeros_like(theta)
+        e[i] = h
+        fd[i] = (loop.hinf(theta + e)[0] - loop.hinf(theta - e)[0]) / (2 * h)
+    np.testing.assert_allclose(g, fd, rtol=1e-4, atol=1e-6 * np.max(np.abs(fd)))
+
+
+# --------------------------------------------------------------------------- against grids
+def test_the_issue_example_runs_as_written():
+    P = plant_a()
+    C = tunable_pid("C", kind="PI")                  # parameters C.kp, C.ki
+    res = hinfstruct(P, C, nmeas=1, ncon=1, starts=5, rng=np.random.default_rng(0))
+    assert set(res.values) == {"C.kp", "C.ki"}
+    assert isinstance(res.K, control.StateSpace)
+    assert res.gamma == hinfnorm(lft(P, res.K))[0]   # certified like hinfsyn
+    K, CL, gamma, info = res
+    assert info is res and gamma == res.gamma and K is res.K
+    assert isinstance(res, HinfstructResult) and len(res.starts) == 5
+    assert hinfnorm(CL)[0] == res.gamma
+
+
+@pytest.mark.parametrize("plant, box", [
+    (plant_a, [(0.0, 5.0), (0.0, 5.0)]),
+    (plant_b, [(-0.5, 1.0), (0.0, 1.5)]),
+    (plant_d, [(0.0, 2.0), (0.0, 2.0)]),
+])
+def test_pi_within_one_percent_of_a_grid_minimum(plant, box):
+    """Grid: 21 × 21 on the box, then 3 rounds of 7 × 7 points over ±1 spacing around the
+    3 best points of the last round (882 norms); final spacing (box width)/20/27: 0.0093
+    on plant a, 0.0028 on b, 0.0037 on d.  Measured 2026-12-02 (2 starts; grid minimum;
+    tuned γ relative to it): a 0.534981, 0.535147, -0.031 %; b 1.649262, 1.655667,
+    -0.39 %; d 0.605885, 0.606129, -0.040 %.  The tuned γ is below every grid minimum:
+    the grid is the looser of the two."""
+    P = plant()
+    res = hinfstruct(P, tunable_pid("C", "PI"), starts=2, rng=np.random.default_rng(0))
+    ref, point, spacing = _grid_min(P, pi_ss, box, (21, 21))
+    kp, ki = res.values["C.kp"], res.values["C.ki"]
+    assert box[0][0] < kp < box[0][1] and box[1][0] < ki < box[1][1]  # the grid's box holds it
+    assert res.gamma == hinfnorm(lft(P, res.K))[0]
+    assert abs(res.gamma / ref - 1) < 0.01, (res.gamma, ref, point)
+
+
+def test_pid_within_one_percent_of_a_grid_minimum():
+    """PID with the filter fixed at 0.05 s on plant d.  Grid: 9 × 9 × 9 on the box, then
+    3 rounds of 5 × 5 × 5 points over ±1 spacing around the 2 best points of the last
+    round (1479 norms); final spacing (box width)/8/8 (0.025, 0.025, 0.00625).  Measured
+    2026-12-02: tuned 0.582386 against the grid's 0.583153 (-0.13 %).  (On plant b the
+    same grid missed the PID's valley: 2.2335 against a tuned 1.589708.)"""
+    P = plant_d()
+    box = [(0.0, 1.6), (0.0, 1.6), (-0.2, 0.2)]
+    res = hinfstruct(P, tunable_pid("C", "PID", tf=0.05), starts=2,
+                     rng=np.random.default_rng(0))
+    ref, point, spacing = _grid_min(P, lambda kp, ki, kd: pid_ss(kp, ki, kd, 0.05), box,
+                                    (9, 9, 9), nref=5, keep=2)
+    v = res.values
+    assert all(lo < v[k] < hi for (lo, hi), k in zip(box, ("C.kp", "C.ki", "C.kd")))
+    assert abs(res.gamma / ref - 1) < 0.01, (res.gamma, ref, point)
+
+
+def test_static_gain_reaches_the_closed_form_optimum():
+    """``x' = -a x + w + u``, ``z = [x; ρ u]``, ``y = x``, ``u = k x``: the loop is
+    ``[1; ρ k]/(s + a - k)``, stable for ``k < a``, with norm
+    ``f(k) = sqrt(1 + ρ²k²)/(a - k)`` at ω = 0; ``d ln f/dk = 0`` gives
+    ``ρ² k a + 1 = 0``: ``k* = -1/(a ρ²)``."""
+    a, rho = 1.0, 0.5
+    P = control.ss([[-a]], [[1.0, 1.0]], [[1.0], [0.0], [1.0]],
+                   [[0.0, 0.0], [0.0, rho], [0.0, 0.0]])
+    k_opt = -1.0 / (a * rho**2)
+    f_opt = np.sqrt(1 + rho**2 * k_opt**2) / (a - k_opt)
+    res = hinfstruct(P, tunable_gain("K", 1, 1), starts=2, rng=np.random.default_rng(1))
+    assert res.values["K.k"] == pytest.approx(k_opt, rel=1e-4)
+    assert res.gamma == pytest.approx(f_opt, rel=1e-8)
+    assert res.gamma >= f_opt * (1 - 1e-9)
+
+
+def test_two_blocks_on_a_decoupled_plant():
+    """Two copies of the static-gain problem side by side: ``K = diag(k1, k2)``, the
+    norm is the larger of the two loops' norms, and the worse loop must sit at its own
+    optimum ``k* = -1/(a ρ²)`` (closed form above)."""
+    loops = [(1.0, 0.5), (2.0, 0.2)]
+    A = np.diag([-a for a, _ in loops])
+    B = np.array([[1.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.0, 1.0]])
+    C = np.array([[1, 0], [0, 1], [0, 0], [0, 0], [1, 0], [0, 1]], dtype=float)
+    D = np.zeros((6, 4))
+    D[2, 2], D[3, 3] = loops[0][1], loops[1][1]
+    P = control.ss(A, B, C, D)
+    f = [np.sqrt(1 + r**2 / (a * r**2) ** 2) / (a + 1 / (a * r**2)) for a, r in loops]
+    worst = int(np.argmax(f))
+    res = hinfstruct(P, [tunable_gain("K1", 1, 1), tunable_gain("K2", 1, 1)], starts=2)
+    assert list(res.values) == ["K1.k", "K2.k"] and res.K.D.shape == (2, 2)
+    assert res.gamma == pytest.approx(max(f), rel=1e-8)
+    a, r = loops[worst]
+    assert res.values[f"K{worst + 1}.k"] == pytest.approx(-1 / (a * r**2), rel=1e-4)
+
+
+# --------------------------------------------------------------------------- full order
+def _slicot_gamma_opt(P, lo, hi, steps=40):
+    """γ bisection over SLICOT sb10ad's suboptimal controllers (job 4): a level counts
+    as achieved where sb10ad returns a controller (slycot raises below the optimum)."""
+    from slycot import sb10ad
+    A, B, C, D = (np.asarray(m, dtype=float) for m in (P.A, P.B, P.C, P.D))
+
+    def achieved(g):
+        try:
+            sb10ad(A.shape[0], B.shape[1], C.shape[0], 1, 1, float(g), A, B, C, D, job=4)
+        except Exception:            # slycot's SlycotArithmeticError / ValueError
+            return False
+        return True
+
+    assert achieved(hi) and not achieved(lo)
+    for _ in range(steps):
+        mid = np.sqrt(lo * hi)
+        lo, hi = (lo, mid) if achieved(mid) else (mid, hi)
+    return lo
+
+
+def _scalar_gamma_opt(a):
+    # DGKF, as in tests/test_hinfsyn.py: X∞(γ) = γ at the optimum (a = 1: 1 + sqrt(3))
+    def x_inf(g):
+        q = 1.0 - g**-2
+        return (a + np.sqrt(a * a + q)) / q
+    return scipy.optimize.brentq(lambda g: x_inf(g) - g, 1.0 + 1e-9, 1e3, xtol=1e-14)
+
+
+def test_full_order_on_a_scalar_plant_reaches_the_dgkf_optimum():
+    """x' = x + w1 + u, z = [x; u], y = x + w2: γ_opt = 1 + √3 (closed form).  A
+    first-order block can reach it; measured 2026-12-02: 2.7320508 (+2.2e-10 relative to
+    the optimum; hinfsyn's certified γ: 2.7327330)."""
+    P = control.ss([[1.0]], [[1.0, 0.0, 1.0]], [[1.0], [0.0], [1.0]],
+                   [[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]])
+    ref = _scalar_gamma_opt(1.0)
+    assert ref == pytest.approx(1 + np.sqrt(3), rel=1e-12)
+    res = hinfstruct(P, tunable_ss("K", 1, 1, 1), starts=2, rng=np.random.default_rng(0))
+    assert res.gamma >= ref * (1 - 1e-6)             # no controller beats the optimum
+    assert res.gamma <= ref * (1 + 1e-3)
+
+
+def test_full_order_on_a_two_state_plant_against_slicot_and_hinfsyn():
+    """Plant a (2 states): the optimum from SLICOT's γ bisection is a lower bound for
+    any controller; hinfsyn's certified γ an achieved level.  Measured 2026-12-02: tuned
+    0.5349488, SLICOT 0.5349487 (+8.4e-8), hinfsyn 0.5349490 (the tuned loop 5e-7 below
+    it: hinfsyn reconstructs its controller at a relaxed level)."""
+    P = plant_a()
+    syn = hinfsyn(P, 1, 1)
+    ref = _slicot_gamma_opt(P, 0.5 * syn.gamma, 1.01 * syn.gamma)
+    res = hinfstruct(P, tunable_ss("K", 2, 1, 1), starts=2, rng=np.random.default_rng(0))
+    assert res.gamma >= ref * (1 - 1e-6)
+    assert res.gamma <= syn.gamma * (1 + 1e-3)
+
+
+def test_full_order_on_a_three_state_plant_within_a_few_percent():
+    """Plant d (3 states).  The H∞-optimal controllers have a pole that runs to -∞ as γ
+    approaches the optimum (SLICOT's at 1.01, 1.001 and 1.0001 times it: -23 ± 10j,
+    -329, -3345 rad/s), so a fixed-order search approaches it by pushing a parameter
+    out, slowly: measured 2026-12-02, 2 starts of 200 iterations, both ending at the
+    iteration bound, against the optimum 0.5803086: 0.5928082 (+2.15 %) under OpenBLAS
+    Haswell, 0.5941402 under Sandybridge, 0.5947135 (+2.48 %) under Nehalem, the same on
+    1 and 2 threads (../shared/tools/kernels).  Path-dependent: the bound below is 5 %;
+    the lower bound holds always."""
+    P = plant_d()
+    syn = hinfsyn(P, 1, 1)
+    ref = _slicot_gamma_opt(P, 0.5 * syn.gamma, 1.01 * syn.gamma)
+    res = hinfstruct(P, tunable_ss("K", 3, 1, 1), starts=2, rng=np.random.default_rng(0))
+    assert res.gamma >= ref * (1 - 1e-6)
+    assert res.gamma <= ref * 1.05
+
+
+
+
+# --------------------------------------------------------------------------- behaviour
+def test_same_seed_same_result_and_the_seed_matters():
+    P = plant_d()
+    C = tunable_pid("C", "PID")
+    short = HinfstructOptions(max_iter=15)
+    r1 = hinfstruct(P, C, starts=3, rng=np.random.default_rng(7), options=short)
+    r2 = hinfstruct(P, C, starts=3, rng=np.random.default_rng(7), options=short)
+    assert r1.gamma == r2.gamma and np.array_equal(r1.theta, r2.theta)
+    assert [s.theta0.tolist() for s in r1.starts] == [s.theta0.tolist() for s in r2.starts]
+    assert [s.theta.tolist() for s in r1.starts] == [s.theta.tolist() for s in r2.starts]
+    r3 = hinfstruct(P, C, starts=2, rng=np.random.default_rng(8), options=short)
+    assert r3.starts[1].theta0.tolist() != r1.starts[1].theta0.tolist()
+    assert r1.starts[0].theta0.tolist() == C.start.tolist()          # the blocks' own start
+    # no rng: default_rng(0), documented
+    r4 = hinfstruct(P, C, starts=2, options=short)
+    r5 = hinfstruct(P, C, starts=2, rng=np.random.default_rng(0), options=short)
+    assert r4.starts[1].theta0.tolist() == r5.starts[1].theta0.tolist()
+
+
+def test_a_destabilising_start_is_stabilised_first():
+    """Plant with a pole at +1: kp = -1 (positive feedback) leaves the loop unstable; the
+    spectral-abscissa phase must find a stabilising PI before the H∞ phase."""
+    P = plant_unstable()
+    res = hinfstruct(P, tunable_pid("C", "PI"), starts=[{"C.kp": -1.0, "C.ki": 0.1}])
+    loop = hs._Loop(GeneralizedPlant.from_statespace(P, 1, 1), tunable_pid("C", "PI"))
+    assert loop.abscissa_fg(np.array([-1.0, 0.1]))[0] > 0
+    assert res.starts[0].stab_iterations >= 1
+    assert res.stable and res.gamma == hinfnorm(lft(P, res.K))[0]
+
+
+def _unstabilisable():
+    # x1' = x1 + w (no control reaches it), x2' = -x2 + u: no controller stabilises
+    return control.ss([[1.0, 0.0], [0.0, -1.0]], [[1.0, 0.0], [0.0, 1.0]],
+                      [[1.0, 1.0], [1.0, 1.0]], [[0.0, 0.0], [0.0, 0.0]])
+
+
+def test_no_stabilising_point_is_a_typed_error_or_a_result_that_says_so():
+    t0 = time.perf_counter()
+    with pytest.raises(IterationLimitError, match="no start reached a stabilising"):
+        hinfstruct(_unstabilisable(), tunable_pid("C", "PI"), starts=2)
+    res = hinfstruct(_unstabilisable(), tunable_pid("C", "PI"), starts=2,
+                     options=HinfstructOptions(on_unstable="return"))
+    assert not res.stable and res.gamma == np.inf
+    assert any("no start reached a stabilising" in w for w in res.warnings)
+    assert time.perf_counter() - t0 < 5.0
+
+
+@pytest.mark.parametrize("call, error", [
+    (lambda: hinfstruct(control.ss([[np.nan]], [[1.0, 1.0]], [[1.0], [1.0]], np.zeros((2, 2))),
+                        tunable_gain("K", 1, 1)), NonFiniteError),
+    (lambda: hinfstruct(control.ss([[0.5]], [[1.0, 1.0]], [[1.0], [1.0]], np.zeros((2, 2)), 0.1),
+                        tunable_gain("K", 1, 1)), DiscreteTimeError),
+    (lambda: hinfstruct(plant_a(), tunable_gain("K", 1, 1), nmeas=3, ncon=1), DimensionError),
+    (lambda: hinfstruct(plant_a(), tunable_gain("K", 2, 1), nmeas=1, ncon=1), DimensionError),
+    (lambda: hinfstruct(plant_a(), tunable_gain("K", 2, 2)), DimensionError),
+    (lambda: hinfstruct(plant_a(), tunable_pid("C", "PI"), starts=[[np.nan, 1.0]]),
+     NonFiniteError),
+    (lambda: hinfstruct(plant_a(), tunable_pid("C", "PI"), starts=[[1.0]]), DimensionError),
+    (lambda: hinfstruct(plant_a(), tunable_pid("C", "PI"), starts=0), ParameterError),
+    (lambda: hinfstruct(plant_a(), tunable_pid("C", "PI"), rng=0), ParameterError),
+    (lambda: hinfstruct(plant_a(), [tunable_pid("C", "PI"), tunable_pid("C", "PI")]),
+     ParameterError),
+    (lambda: hinfstruct(plant_a(), []), ParameterError),
+    (lambda: hinfstruct(plant_a(), "C"), ParameterError),
+    (lambda: tunable_pid("C", "PI", start={"kp": np.nan}), NonFiniteError),
+    (lambda: tunable_pid("C", "PI", fixed={"kp": 1.0, "ki": 2.0}), ParameterError),
+    (lambda: tunable_gain("K", 1, 1, fixed={"k": 0.0}), ParameterError),
+    (lambda: tunable_pid("C", "PIDF"), ParameterError),
+    (lambda: tunable_pid("C", "PI", tf=0.1), ParameterError),
+    (lambda: tunable_pid("C", "PID", tf=-0.1), ParameterError),
+    (lambda: tunable_pid("C", "PID", start={"xx": 1.0}), ParameterError),
+    (lambda: tunable_gain("K", 0, 1), DimensionError),
+    (lambda: tunable_ss("K", -1, 1, 1), DimensionError),
+    (lambda: HinfstructOptions(on_unstable="ignore"), ParameterError),
+])
+def test_bad_input_is_a_typed_error_at_once(call, error):
+    t0 = time.perf_counter()
+    with pytest.raises(error):
+        call()
+    assert time.perf_counter() - t0 < 2.0
+
+
+def test_a_generalized_plant_gives_the_same_result():
+    P = plant_d()
+    C = tunable_pid("C", "PI")
+    short = HinfstructOptions(max_iter=10)
+    r1 = hinfstruct(P, C, options=short)                              # sizes from C
+    r2 = hinfstruct(GeneralizedPlant.from_statespace(P, 1, 1), C, options=short)
+    assert r1.gamma == r2.gamma and np.array_equal(r1.theta, r2.theta)
+    assert r2.gamma == hinfnorm(lft(GeneralizedPlant.from_statespace(P, 1, 1), r2.K))[0]
+
+
+def test_fixed_parameters_are_held():
+    P = plant_d()
+    res = hinfstruct(P, tunable_pid("C", "PID", fixed={"kd": 0.0}, tf=0.05), starts=1)
+    assert list(res.values) == ["C.kp", "C.ki"]
+    assert complex(control.evalfr(res.K, 1e6j)).real == pytest.approx(res.values["C.kp"],
+                                                                       rel=1e-6)
+
+
+# --------------------------------------------------------------------------- hinfnorm's miss
+#: a PID loop on plant d (filter 0.05 s) where σ̄(D) = 0.626407 and σ̄ peaks at 0.629940
+#: near 1.33 rad/s; found by hinfstruct on 2026-12-02
+MISSED_PEAK_THETA = np.array([0.66719338, 0.83679817, 0.0609756])
+
+
+def _missed_peak_loop():
+    P = plant_d()
+    K = tunable_pid("C", "PID", tf=0.05).ss(MISSED_PEAK_THETA)
+    return P, K, lft(P, K)
+
+
+@pytest.mark.xfail(strict=True, reason="lti.norms.hinfnorm returns σ̄(D) = 0.626407 at "
+                   "ω = inf where σ̄ = 0.629940 at 1.33 rad/s: its Hamiltonian at "
+                   "σ̄(D)(1 + 2 rtol) is nearly singular and its imaginary eigenvalues "
+                   "fall outside AXIS_TOL (lti/norms.py, outside this package)")
+def test_hinfnorm_sees_the_peak_above_the_feedthrough():
+    # reference: python-control's linfnorm (SLICOT ab13dd), 0.6299398865 at 1.3285 rad/s
+    # (control 0.10.2, 2026-12-02)
+    _, _, CL = _missed_peak_loop()
+    ref, w_ref = control.linfnorm(CL)
+    assert 1.3 < w_ref < 1.35
+    assert hinfnorm(CL)[0] == pytest.approx(float(ref), rel=1e-7)
+
+
+def _feedthrough_only(sys, **kwargs):
+    """hinfnorm's defect, injected: the feedthrough reported as the norm."""
+    return float(np.linalg.norm(np.asarray(sys.D, dtype=float), 2)), float("inf")
+
+
+def test_the_objective_sees_the_peak_hinfnorm_misses(monkeypatch):
+    P, K, CL = _missed_peak_loop()
+    ref = float(control.linfnorm(CL)[0])          # SLICOT ab13dd: 0.6299398865
+    monkeypatch.setattr(hs, "hinfnorm", _feedthrough_only)
+    loop = hs._Loop(GeneralizedPlant.from_statespace(P, 1, 1), tunable_pid("C", "PID", tf=0.05))
+    f, omega, _ = loop.hinf(MISSED_PEAK_THETA)
+    assert f == pytest.approx(ref, rel=1e-8) and 1.3 < omega < 1.35
+
+
+def test_a_certificate_below_the_sweep_is_reported(monkeypatch, caplog):
+    """Injected: the optimiser returns its start and hinfnorm reports the feedthrough
+    (its defect above); the result's gamma is still hinfnorm's (as promised), and
+    ``warnings`` (and a WARNING record) say that a sweep finds the loop's peak above it."""
+    P = plant_d()
+    monkeypatch.setattr(hs, "_bfgs", lambda fg, x, f, g, *a, **k: (x, f, g, 0, "injected"))
+    monkeypatch.setattr(hs, "hinfnorm", _feedthrough_only)
+    res = hinfstruct(P, tunable_pid("C", "PID", tf=0.05), starts=[MISSED_PEAK_THETA])
+    assert res.gamma == pytest.approx(0.626407, abs=1e-6)        # what hinfnorm said
+    assert any("hinfnorm" in w and "0.62994" in w for w in res.warnings), res.warnings
+    assert any(r.levelname == "WARNING" for r in caplog.records)
