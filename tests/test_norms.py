@@ -162,3 +162,22 @@ def test_sigma_at_a_pole_of_the_realization_is_infinite():
     sig = _sigma(A, B, C, D, np.array([0.5, 1.0, 2.0]))
     assert np.isinf(sig[1])
     np.testing.assert_allclose(sig[[0, 2]], [1 / 0.75, 1 / 3.0], rtol=1e-12)  # |1/(1-ω²)|
+
+
+def test_the_pencil_has_the_hamiltonians_eigenvalues():
+    """Near σ̄(D) hinfnorm takes the Hamiltonian's eigenvalues from a pencil that does not
+    invert γ²I − DᵀD (norms._pencil_eigenvalues); where that inverse is well conditioned
+    (γ = 3 σ̄(D) here) both forms must give the same spectrum (reference: the explicit
+    Hamiltonian of norms._hamiltonian, an independent construction)."""
+    from lmi_suspension.lti import norms
+
+    rng = np.random.default_rng(7)
+    A = rng.standard_normal((4, 4)) - 4.0 * np.eye(4)
+    B, C, D = rng.standard_normal((4, 2)), rng.standard_normal((3, 4)), rng.standard_normal((3, 2))
+    gamma = 3.0 * np.linalg.norm(D, 2)
+    explicit = np.linalg.eigvals(norms._hamiltonian(A, B, C, D, gamma))
+    pencil = norms._pencil_eigenvalues(A, B, C, D, gamma)
+    assert pencil.shape == explicit.shape == (8,)
+    # the same multiset: each eigenvalue of one form has a partner in the other
+    gap = np.abs(pencil[:, None] - explicit[None, :])
+    assert np.max(gap.min(axis=1)) < 1e-9 and np.max(gap.min(axis=0)) < 1e-9
