@@ -193,13 +193,18 @@ class _Block:
         with a trailing axis over the points for an array.
         """
         theta = self._theta(theta)
-        A, B, C, _ = self.matrices(theta)
-        J = self.jacobian(theta)
-        points = np.atleast_1d(np.asarray(s, dtype=complex))
-        out = np.empty((self.n_params, self.noutputs, self.ninputs, points.size), dtype=complex)
-        for k, sk in enumerate(points):
-            out[..., k] = _derivative_at(A, B, C, J, self.noutputs, self.ninputs, sk)
-        return out[..., 0] if np.ndim(s) == 0 else out
+        return _freqresp_derivative(self, theta, s)
+
+
+def _freqresp_derivative(block, theta, s) -> np.ndarray:
+    """``dK/dθ_i`` of ``block`` at the point(s) ``s``, from its matrices and Jacobian."""
+    A, B, C, _ = block.matrices(theta)
+    J = block.jacobian(theta)
+    points = np.atleast_1d(np.asarray(s, dtype=complex))
+    out = np.empty((block.n_params, block.noutputs, block.ninputs, points.size), dtype=complex)
+    for k, sk in enumerate(points):
+        out[..., k] = _derivative_at(A, B, C, J, block.noutputs, block.ninputs, sk)
+    return out[..., 0] if np.ndim(s) == 0 else out
 
 
 def _derivative_at(A, B, C, J, no, ni, s) -> np.ndarray:
@@ -616,13 +621,7 @@ class _BlockDiagonal:
 
     def freqresp_derivative(self, theta, s) -> np.ndarray:
         theta = np.asarray(theta, dtype=float)
-        A, B, C, _ = self.matrices(theta)
-        J = self.jacobian(theta)
-        points = np.atleast_1d(np.asarray(s, dtype=complex))
-        out = np.empty((self.n_params, self.noutputs, self.ninputs, points.size), dtype=complex)
-        for k, sk in enumerate(points):
-            out[..., k] = _derivative_at(A, B, C, J, self.noutputs, self.ninputs, sk)
-        return out[..., 0] if np.ndim(s) == 0 else out
+        return _freqresp_derivative(self, theta, s)
 
 
 _BLOCK_ATTRIBUTES = ("name", "ninputs", "noutputs", "nstates", "param_names", "n_params",
