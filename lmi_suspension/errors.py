@@ -13,7 +13,9 @@ __all__ = [
     "NonFiniteError",
     "DimensionError",
     "ParameterError",
+    "TimebaseError",
     "DiscreteTimeError",
+    "SampleTimeError",
     "IllPosedLoopError",
     "AssumptionError",
     "InfeasibleError",
@@ -44,8 +46,20 @@ class ParameterError(InputError):
     """A physical or numerical parameter is outside its admissible range."""
 
 
-class DiscreteTimeError(InputError):
+class TimebaseError(InputError):
+    """Systems' time bases do not fit: a continuous-time system where a discrete-time one
+    is required or the converse, two different sample times, or a sample time that is not
+    a positive finite number."""
+
+
+class DiscreteTimeError(TimebaseError):
     """A continuous-time system was required and a discrete-time one was given."""
+
+
+class SampleTimeError(TimebaseError):
+    """A sample time that is not positive and finite (or unspecified, ``dt=True``), or
+    systems of different time bases combined (a continuous plant with a discrete
+    controller, two sample times)."""
 
 
 class IllPosedLoopError(InputError):

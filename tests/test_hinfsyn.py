@@ -14,7 +14,7 @@ import pytest
 import scipy.optimize
 from hypothesis import given, settings, strategies as st
 
-from lmi_suspension.errors import (AssumptionError, DimensionError, DiscreteTimeError,
+from lmi_suspension.errors import (AssumptionError, DimensionError, SampleTimeError,
                                    InfeasibleError, NonFiniteError, ParameterError,
                                    SolverError)
 from lmi_suspension.lti import GeneralizedPlant, hinfnorm, lft
@@ -560,8 +560,8 @@ def test_bad_input_raises_typed_errors():
     P = scalar_plant(1.0)
     with pytest.raises(NonFiniteError):
         hinfsyn(control.ss([[np.nan]], [[1.0, 1.0]], [[1.0], [1.0]], np.zeros((2, 2))), 1, 1)
-    with pytest.raises(DiscreteTimeError):
-        hinfsyn(control.ss(P.A, P.sys.B, P.sys.C, P.sys.D, 0.1), 1, 1)
+    with pytest.raises(SampleTimeError):  # discrete plants need a sample time
+        hinfsyn(control.ss(P.A, P.sys.B, P.sys.C, P.sys.D, True), 1, 1)
     with pytest.raises(DimensionError):
         hinfsyn(P.sys, 3, 1)
     with pytest.raises(DimensionError):

@@ -289,8 +289,8 @@ def test_bad_input_is_typed():
     A[0, 0] = np.nan
     with pytest.raises(NonFiniteError):
         msyn(control.ss(A, bad.B, bad.C, bad.D), 1, 1, HinfBound())
-    with pytest.raises(ValueError):  # DiscreteTimeError is a ValueError
-        msyn(control.ss(bad.A, bad.B, bad.C, bad.D, 0.1), 1, 1, HinfBound())
+    with pytest.raises(ValueError):  # SampleTimeError is a ValueError
+        msyn(control.ss(bad.A, bad.B, bad.C, bad.D, True), 1, 1, HinfBound())
 
 
 # ------------------------------------------------- each constraint: active, infeasible

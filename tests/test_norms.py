@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from lmi_suspension.errors import DiscreteTimeError, NonFiniteError, ParameterError
-from lmi_suspension.lti import hinfnorm
+from lmi_suspension.errors import NonFiniteError, ParameterError, SampleTimeError
+from lmi_suspension.lti import freqresp, hinfnorm
 from lmi_suspension.lti.norms import h2norm, is_stable, sigma_max
 from mp_reference import freqresp_mp
 
@@ -96,8 +96,12 @@ def test_h2norm_identities_and_python_control():
 def test_bad_input_raises_typed_errors():
     with pytest.raises(NonFiniteError):
         hinfnorm(control.ss([[np.nan]], [[1.0]], [[1.0]], [[0.0]]))
-    with pytest.raises(DiscreteTimeError):
-        hinfnorm(control.tf([1.0], [1.0, 0.5], dt=0.1))
+    with pytest.raises(SampleTimeError):  # discrete, but with no sample time to map ω
+        hinfnorm(control.tf([1.0], [1.0, 0.5], dt=True))
+    with pytest.raises(SampleTimeError):  # python-control accepts dt=nan
+        hinfnorm(control.ss([[0.5]], [[1.0]], [[1.0]], [[0.0]], float("nan")))
+    with pytest.raises(ParameterError):  # the unit circle has no ω = inf
+        sigma_max(control.tf([1.0], [1.0, 0.5], dt=0.1), [np.inf])
     with pytest.raises(ParameterError):
         hinfnorm(control.tf([1.0], [1.0, 1.0]), rtol=0.0)
     with pytest.raises(ValueError):  # typed errors are ValueErrors too
@@ -181,3 +185,81 @@ def test_the_pencil_has_the_hamiltonians_eigenvalues():
     # the same multiset: each eigenvalue of one form has a partner in the other
     gap = np.abs(pencil[:, None] - explicit[None, :])
     assert np.max(gap.min(axis=1)) < 1e-9 and np.max(gap.min(axis=0)) < 1e-9
+
+
+# ------------------------------------------------------------------ discrete time
+
+def _random_stable_discrete(seed, n, m, p, with_d, dt=0.01):
+    """A random discrete system with spectral radius in [0.3, 0.98]."""
+    rng = np.random.default_rng(seed)
+    A = rng.standard_normal((n, n))
+    A *= rng.uniform(0.3, 0.98) / max(np.abs(np.linalg.eigvals(A)))
+    D = rng.standard_normal((p, m)) if with_d else np.zeros((p, m))
+    return control.ss(A, rng.standard_normal((n, m)), rng.standard_normal((p, n)), D, dt)
+
+
+def test_discrete_first_order_norm_closed_form():
+    # b/(z - a), 0 < a < 1: |G(e^jθ)| is largest at θ = 0, b/(1 - a); for a < 0 at the
+    # Nyquist rate θ = π, b/(1 + a) (closed forms)
+    dt = 0.05
+    gamma, omega = hinfnorm(control.tf([0.3], [1.0, -0.7], dt))
+    assert gamma == pytest.approx(1.0, rel=1e-10) and omega == 0.0
+    gamma, omega = hinfnorm(control.tf([0.3], [1.0, 0.7], dt))
+    assert gamma == pytest.approx(1.0, rel=1e-10)
+    assert omega == pytest.approx(np.pi / dt, rel=1e-6)
+    assert hinfnorm(control.tf([1.0], [1.0, -1.0], dt))[0] == np.inf  # pole at z = 1
+    assert not is_stable(control.tf([1.0], [1.0, 0.0, 1.0], dt))      # poles ±j
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_discrete_norm_against_slycot_and_a_unit_circle_sweep(seed):
+    rng = np.random.default_rng(200 + seed)
+    n, m, p = (int(v) for v in rng.integers(1, 10, size=3))
+    dt = 0.01
+    sys = _random_stable_discrete(seed, n, m, p, with_d=bool(seed % 2), dt=dt)
+    gamma, omega = hinfnorm(sys)
+    # route 1: python-control's own evaluation of G(z) on 4000 points of the unit circle
+    w = np.linspace(0.0, np.pi / dt, 4000)
+    resp = np.asarray(sys(np.exp(1j * w * dt))).reshape(p, m, -1)
+    sweep = np.linalg.norm(resp.transpose(2, 0, 1), 2, axis=(1, 2))
+    assert sweep.max() <= gamma * (1 + 1e-9)
+    assert sigma_max(sys, [omega])[0] == pytest.approx(gamma, rel=1e-9)
+    # route 2: SLICOT AB13DD in discrete mode (its fpeak is the angle θ = ω dt)
+    import slycot
+    A, B, C, D = (np.asarray(M, dtype=float) for M in (sys.A, sys.B, sys.C, sys.D))
+    gpeak, fpeak = slycot.ab13dd("D", "I", "N", "D", n, m, p, A, np.eye(n), B, C, D, 1e-10)
+    assert gamma == pytest.approx(float(gpeak), rel=1e-7)
+
+
+def test_tustin_preserves_the_hinf_norm_and_maps_the_peak_frequency():
+    # the bilinear map without pre-warping sends jω_c to exp(jω dt) with
+    # ω_c = (2/dt) tan(ω dt/2): the same norm, the peak at the mapped frequency
+    for seed in range(4):
+        G = _random_stable(seed, 5, 2, 2, with_d=bool(seed % 2))
+        gamma_c, omega_c = hinfnorm(G)
+        dt = 0.02
+        Gd = control.sample_system(G, dt, method="tustin")
+        gamma_d, omega_d = hinfnorm(Gd)
+        assert gamma_d == pytest.approx(gamma_c, rel=1e-8)
+        if np.isfinite(omega_c) and omega_c > 0:
+            assert 2 / dt * np.tan(omega_d * dt / 2) == pytest.approx(omega_c, rel=1e-3)
+
+
+def test_discrete_h2norm_is_the_energy_of_the_impulse_response():
+    sys = _random_stable_discrete(11, 6, 2, 3, with_d=True)
+    A, B, C, D = (np.asarray(M) for M in (sys.A, sys.B, sys.C, sys.D))
+    # Markov parameters D, CB, CAB, ... summed until they vanish (independent route)
+    energy, Ak = np.sum(D**2), np.eye(6)
+    for _ in range(3000):
+        energy += np.sum((C @ Ak @ B) ** 2)
+        Ak = Ak @ A
+    assert h2norm(sys) == pytest.approx(np.sqrt(energy), rel=1e-10)
+    assert h2norm(control.tf([1.0], [1.0, -1.0], 0.1)) == np.inf
+
+
+def test_discrete_freqresp_is_python_controls_evaluation_on_the_unit_circle():
+    sys = _random_stable_discrete(5, 4, 2, 3, with_d=True, dt=0.001)
+    w = np.array([0.0, 10.0, 1000.0, np.pi / 0.001])
+    ours = freqresp(sys, w)
+    ref = np.asarray(sys(np.exp(1j * w * 0.001))).reshape(3, 2, -1)
+    np.testing.assert_allclose(ours, ref, rtol=1e-10, atol=1e-12)

@@ -8,10 +8,10 @@ import control
 import numpy as np
 
 from ..errors import (DimensionError, DiscreteTimeError, InputError, NonFiniteError,
-                      ParameterError)
+                      ParameterError, SampleTimeError)
 
-__all__ = ["as_finite_array", "as_statespace", "finite_scalar", "positive_scalar",
-           "require_continuous", "require_finite_system"]
+__all__ = ["as_finite_array", "as_statespace", "common_sample_time", "finite_scalar",
+           "positive_scalar", "require_continuous", "require_finite_system", "sample_time"]
 
 
 def as_finite_array(value, name: str, *, ndim: int | None = None, dtype=float) -> np.ndarray:
@@ -49,12 +49,78 @@ def as_finite_array(value, name: str, *, ndim: int | None = None, dtype=float) -
     return arr
 
 
+def sample_time(sys, name: str = "system") -> float:
+    """The sample time of ``sys`` in seconds: ``0.0`` for a continuous-time system (and for
+    python-control's "unspecified" ``dt=None`` of static gains), a positive finite number
+    for a discrete-time one.
+
+    Raises
+    ------
+    SampleTimeError
+        For ``dt=True`` (discrete with an unspecified sample time: frequencies in rad/s
+        need one) and for a sample time that is not a positive finite number (python-control
+        accepts ``dt=nan``).
+
+    Examples
+    --------
+    >>> import control
+    >>> sample_time(control.tf([1], [1, 1])), sample_time(control.tf([1], [1, -0.5], 0.01))
+    (0.0, 0.01)
+    """
+    dt = getattr(sys, "dt", 0)
+    if dt is None:
+        return 0.0
+    if dt is True:
+        raise SampleTimeError(f"{name} is discrete-time with an unspecified sample time "
+                              "(dt=True); give it one in seconds")
+    if isinstance(dt, bool) or not isinstance(dt, numbers.Real):
+        raise SampleTimeError(f"{name} has a sample time {dt!r} that is not a number")
+    dt = float(dt)
+    if not (np.isfinite(dt) and dt >= 0):
+        raise SampleTimeError(f"{name} has sample time dt={dt!r}: it must be positive and "
+                              "finite (or 0 for continuous time)")
+    return dt
+
+
+def common_sample_time(*named) -> float:
+    """The one time base of several systems, given as ``(name, system)`` pairs; a static
+    gain (no states) fits any time base.
+
+    Raises
+    ------
+    SampleTimeError
+        If two of them differ (continuous and discrete, or two sample times), naming both.
+
+    Examples
+    --------
+    >>> import control
+    >>> P = control.ss([[0.5]], [[1.0]], [[1.0]], [[0.0]], 0.1)
+    >>> common_sample_time(("P", P), ("K", control.ss([], [], [], [[2.0]])))
+    0.1
+    """
+    seen = None
+    for name, sys in named:
+        dt = sample_time(sys, name)
+        if getattr(sys, "nstates", 1) == 0 and getattr(sys, "dt", 0) in (None, 0):
+            continue  # a static gain is the same operator in either time base
+        if seen is None:
+            seen = (name, dt)
+        elif dt != seen[1]:
+            def kind(t):
+                return "continuous-time" if t == 0 else f"discrete-time (dt={t!r})"
+            raise SampleTimeError(f"{seen[0]} is {kind(seen[1])} and {name} is {kind(dt)}: "
+                                  "systems of different time bases cannot be combined")
+    return 0.0 if seen is None else seen[1]
+
+
 def require_continuous(sys, name: str = "system") -> None:
     """Raise :class:`DiscreteTimeError` unless ``sys`` is a continuous-time system."""
     dt = getattr(sys, "dt", 0)
     if dt is None:
         # python-control uses dt=None for "unspecified"; treat as continuous.
         return
+    if isinstance(dt, numbers.Number) and not isinstance(dt, bool) and dt != dt:
+        raise SampleTimeError(f"{name} has sample time dt=nan")
     if dt is True or (isinstance(dt, numbers.Number) and dt != 0):
         raise DiscreteTimeError(f"{name} must be continuous-time (dt=0), got dt={dt!r}")
 
@@ -67,11 +133,13 @@ def require_finite_system(sys, name: str = "system") -> None:
             raise NonFiniteError(f"{name}.{label} contains NaN or infinite entries")
 
 
-def as_statespace(sys, name: str = "system") -> control.StateSpace:
-    """Return ``sys`` as a continuous-time, finite :class:`control.StateSpace`.
+def as_statespace(sys, name: str = "system", *, discrete: bool = False
+                  ) -> control.StateSpace:
+    """Return ``sys`` as a finite :class:`control.StateSpace`, continuous-time unless
+    ``discrete`` allows a discrete-time one (with a positive finite sample time).
 
-    Transfer functions and static gains are converted; discrete-time systems and
-    non-finite matrices raise typed errors.
+    Transfer functions and static gains are converted; discrete-time systems (where not
+    allowed), invalid sample times and non-finite matrices raise typed errors.
     """
     if isinstance(sys, control.StateSpace):
         ss = sys
@@ -82,7 +150,10 @@ def as_statespace(sys, name: str = "system") -> control.StateSpace:
     else:
         gain = as_finite_array(sys, name, ndim=2)
         ss = control.ss([], [], [], gain)
-    require_continuous(ss, name)
+    if discrete:
+        sample_time(ss, name)
+    else:
+        require_continuous(ss, name)
     require_finite_system(ss, name)
     return ss
 

@@ -1,4 +1,5 @@
-"""System norms of continuous-time LTI systems: H∞ (Hamiltonian iteration) and H2.
+"""System norms of LTI systems: H∞ (Hamiltonian iteration) and H2, continuous and
+discrete time.
 
 The H∞ norm uses the two-step Hamiltonian iteration of Boyd & Balakrishnan (1990) and
 Bruinsma & Steinbuch (1990): a lower bound ``gamma_lb`` attained at a known frequency
@@ -19,6 +20,15 @@ loses up to four digits (a distillation closed loop gave σ̄ errors of 6e-4 rel
 against a 40-digit evaluation; see tests/test_norms.py), and both the frequency response
 and the Hamiltonian test inherit that error.
 
+A discrete-time system (sample time ``dt``) is evaluated on the unit circle,
+``z = exp(jω dt)`` with ω in rad/s up to the Nyquist rate ``π/dt``.  Its H∞ norm is that
+of its bilinear (Tustin, unwarped) image ``z = (1 + s dt/2) / (1 - s dt/2)``, a
+continuous-time system with the same values on the imaginary axis as the discrete one
+has on the unit circle (``ω_c = (2/dt) tan(ω dt/2)``): the same norm, computed by the
+same iteration, and its peak frequency mapped back.  The realization of the image
+(:func:`_bilinear_image`) keeps ``B`` and ``C`` balanced by ``sqrt(2/dt)`` and needs
+``A + I`` invertible, which every stable discrete system has.
+
 References
 ----------
 S. Boyd, V. Balakrishnan, "A regularity result for the singular values of a transfer
@@ -32,12 +42,13 @@ from __future__ import annotations
 
 import logging
 
+import control
 import numpy as np
 import scipy.linalg
 import scipy.optimize
 
 from ..errors import IterationLimitError, ParameterError
-from .checks import as_statespace
+from .checks import as_statespace, sample_time
 from .scaling import balanced_matrices
 
 __all__ = ["hinfnorm", "h2norm", "sigma_max", "freqresp", "is_stable"]
@@ -64,26 +75,52 @@ def _matrices(sys):
     return (*balanced_matrices(A, B, C), D)
 
 
+def _system(sys):
+    """``A, B, C, D`` of ``sys`` (balanced, as :func:`_matrices`) and its sample time
+    (0 for continuous time)."""
+    ss = as_statespace(sys, "sys", discrete=True)
+    dt = sample_time(ss, "sys")
+    if dt:
+        # balancing is a state similarity, as good for z as for s: the same matrices
+        # through the same code
+        ss = control.ss(ss.A, ss.B, ss.C, ss.D)
+    return (*_matrices(ss), dt)
+
+
+def _stable_poles(p: np.ndarray, dt: float, tol: float) -> bool:
+    if dt:
+        return bool(np.all(np.abs(p) < 1.0 - tol))
+    return bool(np.all(p.real < -tol * np.maximum(1.0, np.abs(p))))
+
+
 def is_stable(sys, *, tol: float = STABILITY_TOL) -> bool:
-    """True if every pole ``p`` of ``sys`` has ``Re p < -tol * max(1, |p|)``.
+    """True if every pole ``p`` of ``sys`` has ``Re p < -tol * max(1, |p|)``
+    (continuous time) or ``|p| < 1 - tol`` (discrete time).
 
     Examples
     --------
     >>> import control
     >>> is_stable(control.tf([1], [1, 1])), is_stable(control.tf([1], [1, 0]))
     (True, False)
+    >>> is_stable(control.tf([1], [1, -0.5], 0.01)), is_stable(control.tf([1], [1, -1], 0.01))
+    (True, False)
     """
-    A = _matrices(sys)[0]
+    A, *_, dt = _system(sys)
     if A.size == 0:
         return True
-    p = np.linalg.eigvals(A)
-    return bool(np.all(p.real < -tol * np.maximum(1.0, np.abs(p))))
+    return _stable_poles(np.linalg.eigvals(A), dt, tol)
+
+
+def _points(omega: np.ndarray, dt: float) -> np.ndarray:
+    """``jω`` or ``exp(jω dt)``."""
+    return np.exp(1j * omega * dt) if dt else 1j * omega
 
 
 def sigma_max(sys, omega) -> np.ndarray:
-    """Largest singular value of ``G(j omega)`` for each ``omega`` (rad/s).
+    """Largest singular value of ``G(j omega)`` (or of ``G(exp(j omega dt))`` for a
+    discrete-time system) for each ``omega`` (rad/s).
 
-    ``omega = inf`` gives ``sigma_max(D)``.
+    ``omega = inf`` gives ``sigma_max(D)`` (continuous time).
 
     Examples
     --------
@@ -91,12 +128,24 @@ def sigma_max(sys, omega) -> np.ndarray:
     >>> float(sigma_max(control.tf([1], [1, 2]), [0.0])[0])
     0.5
     """
-    A, B, C, D = _matrices(sys)
-    return _sigma(A, B, C, D, np.atleast_1d(np.asarray(omega, dtype=float)))
+    A, B, C, D, dt = _system(sys)
+    omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    if dt:
+        _check_discrete_omega(omega)
+        return _sigma_points(A, B, C, D, _points(omega, dt))
+    return _sigma(A, B, C, D, omega)
+
+
+def _check_discrete_omega(omega: np.ndarray) -> None:
+    if not np.all(np.isfinite(omega)):
+        raise ParameterError("frequencies of a discrete-time system must be finite "
+                             "(the unit circle ends at the Nyquist rate pi/dt)")
 
 
 def freqresp(sys, omega) -> np.ndarray:
-    """Frequency response ``G(j omega)`` as an ``(n_out, n_in, n_freq)`` complex array.
+    """Frequency response ``G(j omega)`` as an ``(n_out, n_in, n_freq)`` complex array;
+    for a discrete-time system (sample time ``dt``), ``G(exp(j omega dt))``, with
+    ``omega`` in rad/s (the unit circle's upper half is ``0 <= omega <= pi/dt``).
 
     Evaluated on the balanced realization (see the module docstring); python-control's
     ``frequency_response`` evaluates the realization as given.
@@ -107,14 +156,20 @@ def freqresp(sys, omega) -> np.ndarray:
     >>> G = freqresp(control.tf([1], [1, 1]), [0.0, 1.0])
     >>> G.shape, complex(G[0, 0, 1])
     ((1, 1, 2), (0.5-0.5j))
+    >>> Gz = freqresp(control.tf([1], [1, -0.5], 0.1), [0.0])  # 1/(z - 0.5) at z = 1
+    >>> complex(Gz[0, 0, 0])
+    (2+0j)
     """
-    A, B, C, D = _matrices(sys)
+    A, B, C, D, dt = _system(sys)
     omega = np.atleast_1d(np.asarray(omega, dtype=float))
+    if dt:
+        _check_discrete_omega(omega)
+    points = _points(omega, dt)
     n = A.shape[0]
     out = np.empty((C.shape[0], B.shape[1], omega.size), dtype=complex)
     eye = np.eye(n)
-    for k, w in enumerate(omega):
-        out[:, :, k] = D + (C @ np.linalg.solve(1j * w * eye - A, B) if n else 0.0)
+    for k, z in enumerate(points):
+        out[:, :, k] = D + (C @ np.linalg.solve(z * eye - A, B) if n else 0.0)
     return out
 
 
@@ -143,15 +198,31 @@ def _sigma(A, B, C, D, omegas):
 
 
 def _sigma_batch(A, B, C, D, omegas, eye):
+    return _sigma_batch_at(A, B, C, D, 1j * omegas, eye)
+
+
+def _sigma_points(A, B, C, D, points):
+    """σ̄ of ``C (zI - A)⁻¹ B + D`` at the complex ``points`` (batched as :func:`_sigma`)."""
+    points = np.asarray(points, dtype=complex).ravel()
+    if D.size == 0:
+        return np.zeros(points.size)
+    if A.shape[0] == 0:
+        return np.full(points.size, np.linalg.norm(D, 2))
+    eye = np.eye(A.shape[0])
+    return np.concatenate([_sigma_batch_at(A, B, C, D, points[k:k + _SIGMA_BATCH], eye)
+                           for k in range(0, points.size, _SIGMA_BATCH)] or [np.zeros(0)])
+
+
+def _sigma_batch_at(A, B, C, D, points, eye):
     try:
-        G = C @ np.linalg.solve(1j * omegas[:, None, None] * eye - A, B) + D
+        G = C @ np.linalg.solve(points[:, None, None] * eye - A, B) + D
     except np.linalg.LinAlgError:
-        if omegas.size == 1:
-            # jωI - A exactly singular in floating point: ω is a pole as far as this
+        if points.size == 1:
+            # zI - A exactly singular in floating point: z is a pole as far as this
             # realization can tell, and a certificate must not pass over it
             return np.array([np.inf])
-        return np.concatenate([_sigma_batch(A, B, C, D, omegas[i:i + 1], eye)
-                               for i in range(omegas.size)])
+        return np.concatenate([_sigma_batch_at(A, B, C, D, points[i:i + 1], eye)
+                               for i in range(points.size)])
     return np.linalg.svd(G, compute_uv=False)[:, 0]
 
 
@@ -240,12 +311,13 @@ def _sweep(poles: np.ndarray) -> np.ndarray:
 
 
 def hinfnorm(sys, *, rtol: float = 1e-9, max_iter: int = 100) -> tuple[float, float]:
-    """H∞ norm of a continuous-time system and the frequency where it is attained.
+    """H∞ norm of a system and the frequency where it is attained.
 
     Parameters
     ----------
     sys : control.StateSpace, control.TransferFunction or array_like
-        Continuous-time system (a static gain is allowed).
+        Continuous- or discrete-time system (a static gain is allowed).  A discrete one is
+        measured on the unit circle through its bilinear image (module docstring).
     rtol : float
         Relative accuracy of the returned norm.
     max_iter : int
@@ -254,18 +326,20 @@ def hinfnorm(sys, *, rtol: float = 1e-9, max_iter: int = 100) -> tuple[float, fl
     Returns
     -------
     gamma : float
-        ``sup_w sigma_max(G(jw))``, a value attained at ``omega`` and within ``rtol``
-        (relative) of the supremum.  ``inf`` if the system is not internally stable
-        (a pole with ``Re p >= -1e-12 max(1, |p|)``, hidden modes included).
+        ``sup_w sigma_max(G(jw))`` (``G(exp(jw dt))`` in discrete time), a value attained
+        at ``omega`` and within ``rtol`` (relative) of the supremum.  ``inf`` if the system
+        is not internally stable (a pole with ``Re p >= -1e-12 max(1, |p|)``, or
+        ``|p| >= 1 - 1e-12`` in discrete time, hidden modes included).
     omega : float
         Peak frequency in rad/s (``inf`` if the supremum is the feedthrough at
         infinite frequency; for unstable systems the ``|Im p|`` of the pole nearest to
-        or right of the imaginary axis).
+        or right of the imaginary axis, in discrete time the angle of the pole farthest
+        out divided by ``dt``; at most ``pi/dt`` in discrete time).
 
     Raises
     ------
-    DiscreteTimeError, NonFiniteError
-        For discrete-time or non-finite systems.
+    SampleTimeError, NonFiniteError
+        For an invalid sample time or non-finite systems.
     IterationLimitError
         If ``max_iter`` iterations do not meet the tolerance.
 
@@ -275,12 +349,52 @@ def hinfnorm(sys, *, rtol: float = 1e-9, max_iter: int = 100) -> tuple[float, fl
     >>> gamma, omega = hinfnorm(control.tf([1], [1, 0.5]))  # 1/(s+a): 1/a at w = 0
     >>> round(gamma, 9), omega
     (2.0, 0.0)
+    >>> gamma, omega = hinfnorm(control.tf([0.5], [1, -0.5], 0.1))  # peak 1 at z = 1
+    >>> round(gamma, 9), omega
+    (1.0, 0.0)
     """
     if not (rtol > 0 and np.isfinite(rtol)):
         raise ParameterError(f"rtol must be positive, got {rtol!r}")
     if int(max_iter) < 1:
         raise ParameterError(f"max_iter must be >= 1, got {max_iter!r}")
-    A, B, C, D = _matrices(sys)
+    A, B, C, D, dt = _system(sys)
+    if dt:
+        return _hinfnorm_discrete(A, B, C, D, dt, rtol, int(max_iter))
+    return _hinfnorm(A, B, C, D, rtol, int(max_iter))
+
+
+def _bilinear_image(A, B, C, D, dt: float):
+    """The continuous-time image of ``(A, B, C, D)`` under ``z = (1 + s dt/2)/(1 - s dt/2)``:
+    ``Ac = a (A + I)⁻¹ (A - I)``, ``Bc = sqrt(2a) (A + I)⁻¹ B``, ``Cc = sqrt(2a) C (A + I)⁻¹``,
+    ``Dc = D - C (A + I)⁻¹ B`` with ``a = 2/dt``; ``Gc(jω_c) = G(exp(jω dt))`` for
+    ``ω_c = a tan(ω dt/2)``.  ``A + I`` must be invertible (no pole at ``z = -1``)."""
+    n = A.shape[0]
+    a = 2.0 / dt
+    lu = scipy.linalg.lu_factor(A + np.eye(n))
+    AiB = scipy.linalg.lu_solve(lu, B)
+    CAi = scipy.linalg.lu_solve(lu, C.T, trans=1).T
+    Ac = a * scipy.linalg.lu_solve(lu, A - np.eye(n))
+    r = np.sqrt(2.0 * a)
+    return Ac, r * AiB, r * CAi, D - C @ AiB
+
+
+def _hinfnorm_discrete(A, B, C, D, dt, rtol, max_iter):
+    n = A.shape[0]
+    sig_d = float(np.linalg.norm(D, 2)) if D.size else 0.0
+    if n == 0 or B.shape[1] == 0 or C.shape[0] == 0:
+        return sig_d, 0.0
+    poles = np.linalg.eigvals(A)
+    if not _stable_poles(poles, dt, STABILITY_TOL):
+        worst = poles[np.argmax(np.abs(poles))]
+        return float("inf"), float(abs(np.angle(worst)) / dt)
+    Ac, Bc, Cc, Dc = _bilinear_image(A, B, C, D, dt)
+    gamma, wc = _hinfnorm(*balanced_matrices(Ac, Bc, Cc), Dc, rtol, max_iter)
+    # ω_c = ∞ is z = -1, the Nyquist rate
+    return gamma, (float(2.0 / dt * np.arctan(wc * dt / 2.0)) if np.isfinite(wc) else np.pi / dt)
+
+
+def _hinfnorm(A, B, C, D, rtol: float, max_iter: int) -> tuple[float, float]:
+    """The iteration of :func:`hinfnorm` on a balanced continuous-time realization."""
     n = A.shape[0]
     sig_d = float(np.linalg.norm(D, 2)) if D.size else 0.0
     if n == 0 or B.shape[1] == 0 or C.shape[0] == 0:
@@ -346,29 +460,37 @@ def hinfnorm(sys, *, rtol: float = 1e-9, max_iter: int = 100) -> tuple[float, fl
 
 
 def h2norm(sys) -> float:
-    """H2 norm of a continuous-time system via the controllability Gramian.
+    """H2 norm via the controllability Gramian.
 
-    ``||G||_2^2 = trace(C P C^T)`` with ``A P + P A^T + B B^T = 0``.
+    Continuous time: ``||G||_2^2 = trace(C P Cᵀ)`` with ``A P + P Aᵀ + B Bᵀ = 0`` (infinite
+    when ``D != 0``).  Discrete time: ``||G||_2^2 = trace(C P Cᵀ + D Dᵀ)`` with
+    ``A P Aᵀ - P + B Bᵀ = 0``, the energy of the impulse response.
 
     Returns
     -------
     float
-        ``inf`` when the system is not internally stable or ``D != 0``.
+        ``inf`` when the system is not internally stable or (continuous time) ``D != 0``.
 
     Examples
     --------
     >>> import control
     >>> round(h2norm(control.tf([1], [1, 2])), 12)  # sqrt(1/(2a)) for 1/(s+a)
     0.5
+    >>> round(h2norm(control.tf([1, 0], [1, -0.6], 1.0)), 12)  # sum of 0.36^k = 1/0.64
+    1.25
     """
-    A, B, C, D = _matrices(sys)
-    if np.any(D != 0):
+    A, B, C, D, dt = _system(sys)
+    if not dt and np.any(D != 0):
         return float("inf")
     n = A.shape[0]
     if n == 0:
-        return 0.0
-    if not is_stable(sys):
+        return float(np.linalg.norm(D)) if dt else 0.0
+    if not _stable_poles(np.linalg.eigvals(A), dt, STABILITY_TOL):
         return float("inf")
-    P = scipy.linalg.solve_continuous_lyapunov(A, -B @ B.T)
+    if dt:
+        P = scipy.linalg.solve_discrete_lyapunov(A, B @ B.T)
+    else:
+        P = scipy.linalg.solve_continuous_lyapunov(A, -B @ B.T)
     P = (P + P.T) / 2
-    return float(np.sqrt(max(0.0, float(np.trace(C @ P @ C.T)))))
+    value = float(np.trace(C @ P @ C.T)) + (float(np.sum(D * D)) if dt else 0.0)
+    return float(np.sqrt(max(0.0, value)))

@@ -20,7 +20,8 @@ import control
 import numpy as np
 
 from ..errors import DimensionError, IllPosedLoopError
-from .checks import as_finite_array, as_statespace
+from .checks import (as_finite_array, as_statespace, common_sample_time, require_continuous,
+                     sample_time)
 
 __all__ = ["GeneralizedPlant", "lft", "partition_sizes"]
 
@@ -92,23 +93,29 @@ class GeneralizedPlant:
 
     # ----------------------------------------------------------------- builders
     @classmethod
-    def from_statespace(cls, P, nmeas: int, ncon: int) -> "GeneralizedPlant":
+    def from_statespace(cls, P, nmeas: int, ncon: int, *, discrete: bool = False
+                        ) -> "GeneralizedPlant":
         """Wrap a plant whose last ``ncon`` inputs are controls and last ``nmeas`` outputs
-        are measurements."""
+        are measurements; a discrete-time plant only where the caller allows it
+        (``discrete=True``), else :class:`~lmi_suspension.errors.DiscreteTimeError`."""
         if isinstance(P, GeneralizedPlant):
             if (P.ny, P.nu) != (nmeas, ncon):
                 raise DimensionError(
                     f"plant carries partition ny={P.ny}, nu={P.nu}; got nmeas={nmeas}, ncon={ncon}"
                 )
+            if not discrete:
+                require_continuous(P, "P")
             return P
-        ss = as_statespace(P, "P")
+        ss = as_statespace(P, "P", discrete=discrete)
         nw, nu, nz, ny = partition_sizes(ss, nmeas, ncon)
         return cls(ss, nw, nu, nz, ny)
 
     @classmethod
     def from_matrices(cls, A, B1, B2, C1, C2, D11=None, D12=None, D21=None, D22=None,
-                      *, input_names=None, output_names=None) -> "GeneralizedPlant":
-        """Assemble a plant from its nine blocks; missing ``D`` blocks are zero."""
+                      *, input_names=None, output_names=None, dt: float = 0.0
+                      ) -> "GeneralizedPlant":
+        """Assemble a plant from its nine blocks; missing ``D`` blocks are zero; ``dt`` is
+        the sample time (0 for continuous time)."""
         A = as_finite_array(A, "A", ndim=2)
         n = A.shape[0]
         if A.shape != (n, n):
@@ -144,13 +151,19 @@ class GeneralizedPlant:
         if output_names is not None:
             kwargs["outputs"] = list(output_names)
         sys = control.ss(A, np.hstack([B1, B2]), np.vstack([C1, C2]),
-                         np.block([[D11, D12], [D21, D22]]), **kwargs)
+                         np.block([[D11, D12], [D21, D22]]), dt, **kwargs)
+        sample_time(sys, "the plant")
         return cls(sys, nw, nu, nz, ny)
 
     # ----------------------------------------------------------------- blocks
     @property
     def nstates(self) -> int:
         return self.sys.nstates
+
+    @property
+    def dt(self) -> float:
+        """Sample time in seconds (0 for a continuous-time plant)."""
+        return sample_time(self.sys, "the plant")
 
     @property
     def A(self) -> np.ndarray:
@@ -212,10 +225,14 @@ def lft(P, K, nmeas: int | None = None, ncon: int | None = None) -> control.Stat
     Returns
     -------
     control.StateSpace
-        The closed loop from ``w`` to ``z``; states ordered ``[x_P; x_K]``.
+        The closed loop from ``w`` to ``z``; states ordered ``[x_P; x_K]``; in the time
+        base of ``P`` and ``K`` (both continuous, or both discrete with one sample time;
+        a static gain fits either).
 
     Raises
     ------
+    SampleTimeError
+        If ``P`` and ``K`` have different time bases.
     IllPosedLoopError
         If ``I - D22 D_K`` is singular (numerically: condition number above 1e12).
     DimensionError
@@ -231,14 +248,16 @@ def lft(P, K, nmeas: int | None = None, ncon: int | None = None) -> control.Stat
     >>> float(CL.A[0, 0])
     -2.0
     """
-    K = as_statespace(K, "K")
+    K = as_statespace(K, "K", discrete=True)
     if isinstance(P, GeneralizedPlant):
         if nmeas is not None and nmeas != P.ny or ncon is not None and ncon != P.nu:
             raise DimensionError("nmeas/ncon disagree with the plant's own partition")
         G = P
     else:
         G = GeneralizedPlant.from_statespace(
-            P, K.ninputs if nmeas is None else nmeas, K.noutputs if ncon is None else ncon)
+            P, K.ninputs if nmeas is None else nmeas, K.noutputs if ncon is None else ncon,
+            discrete=True)
+    dt = common_sample_time(("the plant", G.sys), ("the controller", K))
     if (K.ninputs, K.noutputs) != (G.ny, G.nu):
         raise DimensionError(
             f"K maps {K.ninputs} inputs to {K.noutputs} outputs; the plant has "
@@ -273,4 +292,4 @@ def lft(P, K, nmeas: int | None = None, ncon: int | None = None) -> control.Stat
                      outputs=list(G.sys.output_labels[: G.nz]))
     except AttributeError:  # pragma: no cover - very old python-control
         pass
-    return control.ss(Acl, Bcl, Ccl, Dcl, **names)
+    return control.ss(Acl, Bcl, Ccl, Dcl, dt, **names)

@@ -120,15 +120,16 @@ class PlantScaling:
         f = float(_pow2(factor))
         b = P.blocks()
         Ps = GeneralizedPlant.from_matrices(b["A"], b["B1"], b["B2"], b["C1"] / f, b["C2"],
-                                            b["D11"] / f, b["D12"] / f, b["D21"], b["D22"])
+                                            b["D11"] / f, b["D12"] / f, b["D21"], b["D22"],
+                                            dt=P.dt)
         return Ps, replace(self, cz=self.cz * f)
 
     def controller_to_original(self, Ks) -> control.StateSpace:
         """Map a controller of the scaled plant back: ``K = Su K_s Sy``."""
-        Ks = as_statespace(Ks, "K")
+        Ks = as_statespace(Ks, "K", discrete=True)
         Su, Sy = np.diag(self.Su), np.diag(self.Sy)
         return control.ss(Ks.A, np.asarray(Ks.B) @ Sy, Su @ np.asarray(Ks.C),
-                          Su @ np.asarray(Ks.D) @ Sy)
+                          Su @ np.asarray(Ks.D) @ Sy, Ks.dt)
 
 
 def scale_plant(P: GeneralizedPlant, *, states: bool = True, io: bool = True
@@ -166,7 +167,7 @@ def scale_plant(P: GeneralizedPlant, *, states: bool = True, io: bool = True
         cz = float(_pow2(np.linalg.norm(np.hstack([C1, D11 * cw, D12]), 2)))
         B1, D11, D21 = B1 * cw, D11 * (cw / cz), D21 * cw
         C1, D12 = C1 / cz, D12 / cz
-    Ps = GeneralizedPlant.from_matrices(A, B1, B2, C1, C2, D11, D12, D21, D22)
+    Ps = GeneralizedPlant.from_matrices(A, B1, B2, C1, C2, D11, D12, D21, D22, dt=P.dt)
     return Ps, PlantScaling(T=T, Su=Su, Sy=Sy, cw=cw, cz=cz)
 
 
@@ -194,4 +195,4 @@ def transform_states(P: GeneralizedPlant, T) -> GeneralizedPlant:
     A = np.linalg.solve(T, b["A"] @ T)
     B1, B2 = np.linalg.solve(T, b["B1"]), np.linalg.solve(T, b["B2"])
     return GeneralizedPlant.from_matrices(A, B1, B2, b["C1"] @ T, b["C2"] @ T, b["D11"],
-                                          b["D12"], b["D21"], b["D22"])
+                                          b["D12"], b["D21"], b["D22"], dt=P.dt)

@@ -18,13 +18,16 @@ RANK_TOL = 1e-10
 AXIS_TOL = 1e-8
 
 
-def _unstable_modes(A: np.ndarray) -> np.ndarray:
+def _unstable_modes(A: np.ndarray, dt: float = 0.0) -> np.ndarray:
     ev = np.linalg.eigvals(A)
+    if dt:
+        return ev[np.abs(ev) >= 1.0 - 1e-12]
     return ev[ev.real >= -1e-12 * np.maximum(1.0, np.abs(ev))]
 
 
 def check_stabilizable(P: GeneralizedPlant) -> None:
-    """PBH tests: ``(A, B2)`` stabilisable and ``(C2, A)`` detectable.
+    """PBH tests: ``(A, B2)`` stabilisable and ``(C2, A)`` detectable (modes on or
+    outside the unit circle for a discrete-time plant).
 
     Raises
     ------
@@ -48,15 +51,16 @@ def check_stabilizable(P: GeneralizedPlant) -> None:
         return
     scale_b = max(1.0, np.linalg.norm(np.hstack([A, B2]), 2))
     scale_c = max(1.0, np.linalg.norm(np.vstack([A, C2]), 2))
-    for lam in _unstable_modes(A):
+    kind = "z" if P.dt else "s"
+    for lam in _unstable_modes(A, P.dt):
         M = np.hstack([A - lam * np.eye(n), B2])
         if np.linalg.svd(M, compute_uv=False)[-1] <= PBH_TOL * scale_b:
             raise InfeasibleError(f"(A, B2) is not stabilisable: the unstable mode "
-                                  f"s = {_fmt(lam)} is uncontrollable from the controls u")
+                                  f"{kind} = {_fmt(lam)} is uncontrollable from the controls u")
         M = np.vstack([A - lam * np.eye(n), C2])
         if np.linalg.svd(M, compute_uv=False)[-1] <= PBH_TOL * scale_c:
             raise InfeasibleError(f"(C2, A) is not detectable: the unstable mode "
-                                  f"s = {_fmt(lam)} is unobservable from the measurements y")
+                                  f"{kind} = {_fmt(lam)} is unobservable from the measurements y")
 
 
 def _fmt(lam: complex) -> str:
@@ -68,7 +72,8 @@ def check_riccati_assumptions(P: GeneralizedPlant) -> None:
 
     1. ``D12`` has full column rank; 2. ``D21`` has full row rank;
     3. ``[[A - jwI, B2], [C1, D12]]`` has full column rank for all real ``w``;
-    4. ``[[A - jwI, B1], [C2, D21]]`` has full row rank for all real ``w``.
+    4. ``[[A - jwI, B1], [C2, D21]]`` has full row rank for all real ``w``
+    (for a discrete-time plant, ``exp(jw)`` in place of ``jw``: SLICOT SB10DD's A3, A4).
 
     Raises
     ------
@@ -103,7 +108,13 @@ def check_riccati_assumptions(P: GeneralizedPlant) -> None:
         if b["A"].shape[0] == 0:
             continue
         z = control.ss(*sysargs).zeros()
-        on_axis = z[np.abs(np.real(z)) <= AXIS_TOL * np.maximum(1.0, np.abs(z))]
+        if P.dt:
+            on_axis = z[np.abs(np.abs(z) - 1.0) <= AXIS_TOL]
+            where = "z", "the unit circle"
+        else:
+            on_axis = z[np.abs(np.real(z)) <= AXIS_TOL * np.maximum(1.0, np.abs(z))]
+            where = "s", "the imaginary axis"
         if on_axis.size:
-            raise AssumptionError(f"{label}; it drops rank at s = {_fmt(complex(on_axis[0]))} "
-                                  "(an invariant zero on the imaginary axis)")
+            raise AssumptionError(f"{label}; it drops rank at {where[0]} = "
+                                  f"{_fmt(complex(on_axis[0]))} (an invariant zero on "
+                                  f"{where[1]})")

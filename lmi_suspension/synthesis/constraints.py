@@ -20,6 +20,15 @@ The protocol (:class:`Specification`)::
 variable for the objective); ``slack`` is the margin every strict inequality keeps
 (``L <= -slack I``), which the synthesis maximises when it reconstructs the controller.
 
+**Discrete time.**  For a plant with sample time ``v.dt > 0`` the same congruence turns the
+discrete-time inequalities (``Aclᵀ P Acl - P ...``, with ``calA`` standing for
+``Πᵀ P Acl Π`` exactly as in continuous time) into LMIs in the same expressions; a
+specification writes its discrete form when ``v.dt`` is set.  :class:`HinfBound`,
+:class:`H2Bound` and :class:`Disk` have one; :class:`HalfPlane` becomes the disk
+``|z| < exp(-alpha dt)`` (the image of ``Re s < -alpha`` under ``z = exp(s dt)``, exact);
+:class:`Sector` and :class:`PeakBound` raise :class:`~lmi_suspension.errors.NotBuiltError`
+(the image of a damping sector is not an LMI region).
+
 A specification with a ``channel`` (:class:`Channel`) may set ``lyapunov_scalable = True``
 when its bound is a norm of the channel (it scales with the channel's outputs) and its
 LMIs certify it for the Lyapunov matrix ``alpha P`` as well as for ``P`` -- true of the
@@ -41,8 +50,8 @@ import cvxpy as cp
 import numpy as np
 import scipy.linalg
 
-from ..errors import DimensionError, ParameterError
-from ..lti.norms import hinfnorm
+from ..errors import DimensionError, NotBuiltError, ParameterError
+from ..lti.norms import h2norm, hinfnorm
 
 __all__ = ["Specification", "LmiVariables", "StateFeedbackVariables", "Channel", "HinfBound", "H2Bound", "PeakBound",
            "HalfPlane", "Disk", "Sector"]
@@ -103,6 +112,8 @@ class LmiVariables:
     Dh: cp.Variable
     data: dict = field(repr=False)
     scale: np.ndarray = None
+    #: sample time of the plant (0: continuous time), for the specifications' LMIs
+    dt: float = 0.0
 
     def __post_init__(self):
         if self.scale is None:
@@ -198,6 +209,8 @@ class StateFeedbackVariables:
     Lh: cp.Variable
     data: dict = field(repr=False)
     scale: np.ndarray = None
+    #: state feedback is built for continuous time only
+    dt: float = 0.0
 
     def __post_init__(self):
         if self.scale is None:
@@ -272,6 +285,19 @@ def _sub(CL: control.StateSpace, ch: Channel):
             np.asarray(CL.D)[np.ix_(rows, cols)])
 
 
+def _sub_system(CL: control.StateSpace, ch: Channel) -> control.StateSpace:
+    """The channel of ``CL`` as a system in ``CL``'s time base."""
+    return control.ss(*_sub(CL, ch), CL.dt or 0)
+
+
+def _discrete(v) -> bool:
+    return bool(getattr(v, "dt", 0.0))
+
+
+def _not_in_discrete_time(what: str, instead: str) -> NotBuiltError:
+    return NotBuiltError(f"{what} is built for continuous-time plants only; {instead}")
+
+
 def _gramian(A, B) -> np.ndarray:
     if not np.all(np.linalg.eigvals(A).real < 0):
         return np.full((A.shape[0], A.shape[0]), np.inf)
@@ -290,14 +316,22 @@ class HinfBound:
     def lmis(self, v: LmiVariables, level, slack) -> list:
         B, C, D = v.B(self.channel), v.C(self.channel), v.D(self.channel)
         nw, nz = B.shape[1], C.shape[0]
+        if _discrete(v):
+            # discrete bounded-real lemma (Gahinet & Apkarian 1994, Sec. 5), congruent to
+            # [[P, P Acl, P Bcl, 0], [., P, 0, Cclᵀ], [., ., γI, Dclᵀ], [., ., ., γI]] > 0
+            n2 = v.calX.shape[0]
+            M = _sym(cp.bmat([[v.calX, v.calA, B, np.zeros((n2, nz))],
+                              [v.calA.T, v.calX, np.zeros((n2, nw)), C.T],
+                              [B.T, np.zeros((nw, n2)), level * np.eye(nw), D.T],
+                              [np.zeros((nz, n2)), C, D, level * np.eye(nz)]]))
+            return [M >> slack * np.eye(M.shape[0])]
         M = _sym(cp.bmat([[v.calA + v.calA.T, B, C.T],
                           [B.T, -level * np.eye(nw), D.T],
                           [C, D, -level * np.eye(nz)]]))
         return [M << -slack * np.eye(M.shape[0])]
 
     def certify(self, CL) -> float:
-        A, B, C, D = _sub(CL, self.channel)
-        return float(hinfnorm(control.ss(A, B, C, D))[0])
+        return float(hinfnorm(_sub_system(CL, self.channel))[0])
 
 
 def _no_feedthrough(v: LmiVariables, ch: Channel, what: str) -> list:
@@ -322,6 +356,19 @@ class H2Bound:
         B, C = v.B(self.channel), v.C(self.channel)
         nw, nz = B.shape[1], C.shape[0]
         Q = cp.Variable((nz, nz), symmetric=True)
+        if _discrete(v):
+            # ‖T‖₂² = trace(C W Cᵀ + D Dᵀ) for any W > A W Aᵀ + B Bᵀ (the controllability
+            # Gramian's inequality), by Schur complements with P = W⁻¹: M1 is that
+            # inequality after the congruence diag(P, P, I), M2 says Q > C W Cᵀ + D Dᵀ
+            D = v.D(self.channel)
+            n2 = v.calX.shape[0]
+            M1 = _sym(cp.bmat([[v.calX, v.calA, B],
+                               [v.calA.T, v.calX, np.zeros((n2, nw))],
+                               [B.T, np.zeros((nw, n2)), np.eye(nw)]]))
+            M2 = _sym(cp.bmat([[Q, C, D], [C.T, v.calX, np.zeros((n2, nw))],
+                               [D.T, np.zeros((nw, n2)), np.eye(nw)]]))
+            return [M1 >> slack * np.eye(M1.shape[0]), M2 >> slack * np.eye(M2.shape[0]),
+                    cp.trace(Q) <= level]
         M1 = _sym(cp.bmat([[v.calA + v.calA.T, B], [B.T, -np.eye(nw)]]))
         M2 = _sym(cp.bmat([[v.calX, C.T], [C, Q]]))
         # ‖T‖₂² < ν: level is ν = bound² (squared so that the LMI stays affine)
@@ -329,6 +376,8 @@ class H2Bound:
                 cp.trace(Q) <= level] + _no_feedthrough(v, self.channel, self.name)
 
     def certify(self, CL) -> float:
+        if CL.dt:
+            return float(h2norm(_sub_system(CL, self.channel)))
         A, B, C, D = _sub(CL, self.channel)
         if np.any(D):
             return float("inf")
@@ -353,6 +402,9 @@ class PeakBound:
         return max(self.bounds) if self.bounds else None
 
     def lmis(self, v: LmiVariables, level, slack) -> list:
+        if _discrete(v):
+            raise _not_in_discrete_time("PeakBound", "bound the channel's H2 norm instead "
+                                        "(H2Bound), which bounds every output's peak")
         B, C = v.B(self.channel), v.C(self.channel)
         nw, nz = B.shape[1], C.shape[0]
         if len(self.bounds) != nz:
@@ -390,6 +442,9 @@ class HalfPlane:
     bound = None
 
     def lmis(self, v, level, slack) -> list:
+        if _discrete(v):
+            # Re s < -alpha  <=>  |z| < exp(-alpha dt) for z = exp(s dt)
+            return Disk(radius=float(np.exp(-self.alpha * v.dt))).lmis(v, level, slack)
         M = _sym(v.calA + v.calA.T + 2 * self.alpha * v.calX)
         return [M << -slack * np.eye(M.shape[0])]
 
@@ -397,15 +452,21 @@ class HalfPlane:
         return p.real < -self.alpha
 
     def certify(self, CL) -> float:
-        """Largest ``Re p + alpha`` over the closed-loop poles (< 0 when met)."""
+        """Largest ``Re p + alpha`` over the closed-loop poles (< 0 when met); in discrete
+        time over ``log(p) / dt``, the poles' continuous-time images."""
         p = np.linalg.eigvals(np.asarray(CL.A))
-        return float(np.max(p.real + self.alpha)) if p.size else -np.inf
+        if not p.size:
+            return -np.inf
+        re = np.log(np.maximum(np.abs(p), 1e-300)) / CL.dt if CL.dt else p.real
+        return float(np.max(re + self.alpha))
 
 
 @dataclass(frozen=True)
 class Disk:
     """Closed-loop poles in the disk ``|s + center| < radius`` (``center >= radius``
-    keeps it in the left half-plane: bounds the natural frequencies)."""
+    keeps it in the left half-plane: bounds the natural frequencies); for a
+    discrete-time plant the disk ``|z + center| < radius`` of the z-plane (``radius < 1``
+    and ``center = 0``: a decay of ``log(radius)/dt`` per second)."""
 
     radius: float
     center: float = 0.0
@@ -438,6 +499,10 @@ class Sector:
     bound = None
 
     def lmis(self, v, level, slack) -> list:
+        if _discrete(v):
+            raise _not_in_discrete_time("Sector", "the image of a damping sector under "
+                                        "z = exp(s dt) is not an LMI region; a Disk of the "
+                                        "z-plane inside it bounds the damping from below")
         A = v.calA
         s, c = np.sin(self.theta), np.cos(self.theta)
         M = _sym(cp.bmat([[s * (A + A.T), c * (A - A.T)], [c * (A.T - A), s * (A + A.T)]]))

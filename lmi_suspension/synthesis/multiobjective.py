@@ -120,7 +120,7 @@ def _variables(Ps: GeneralizedPlant, scale=None) -> LmiVariables:
                         Yh=cp.Variable((n, n), symmetric=True),
                         Ah=cp.Variable((n, n)), Bh=cp.Variable((n, ny)),
                         Ch=cp.Variable((nu, n)), Dh=cp.Variable((nu, ny)), data=Ps.blocks(),
-                        scale=scale)
+                        scale=scale, dt=Ps.dt)
 
 
 def _controller(v: LmiVariables) -> control.StateSpace:
@@ -134,7 +134,7 @@ def _controller(v: LmiVariables) -> control.StateSpace:
     Ck = np.linalg.solve(MT.T, (Ch - Dk @ C2 @ Y).T).T
     inner = Ah - X @ B2 @ Ck @ MT - Bk @ C2 @ Y - X @ (A + B2 @ Dk @ C2) @ Y
     Ak = np.linalg.solve(MT.T, inner.T).T
-    return control.ss(Ak, Bk, Ck, Dk)
+    return control.ss(Ak, Bk, Ck, Dk, v.dt)
 
 
 def _level_of(spec) -> str:
@@ -195,7 +195,8 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
     """
     t0 = time.perf_counter()
     G = GeneralizedPlant.from_statespace(
-        P if isinstance(P, GeneralizedPlant) else as_statespace(P, "P"), nmeas, ncon)
+        P if isinstance(P, GeneralizedPlant) else as_statespace(P, "P", discrete=True),
+        nmeas, ncon, discrete=True)
     if np.any(G.blocks()["D22"]):
         raise ParameterError("msyn needs D22 = 0 (loop shifting is not implemented here)")
     return _synthesise(G, objective, constraints, options, lyapunov_scales, _OUTPUT_FEEDBACK,
@@ -214,7 +215,8 @@ class _Form:
 
 
 def _output_feedback_controller(v: LmiVariables, specs) -> control.StateSpace:
-    _zero_feedthrough(v, specs)
+    if not v.dt:  # a discrete H2 norm allows a feedthrough
+        _zero_feedthrough(v, specs)
     return _controller(v)
 
 
@@ -222,9 +224,12 @@ _OUTPUT_FEEDBACK = _Form(_variables, _output_feedback_controller)
 
 
 def _synthesise(G: GeneralizedPlant, objective, constraints, options, lyapunov_scales,
-                form: _Form, t0: float) -> MultiobjectiveResult:
+                form: _Form, t0: float, *, level_relax: float = _LEVEL_RELAX
+                ) -> MultiobjectiveResult:
     """The body of :func:`msyn` and :func:`~.statefeedback.msfsyn`: minimise, frame
-    rounds, reconstruction ladder, certificates."""
+    rounds, reconstruction ladder, certificates; ``level_relax`` is the relative level
+    above the optimum of the reconstruction's first rung (``hinfsyn`` on a discrete plant
+    passes its ``gamma_relax``)."""
     opts = HinfsynOptions() if options is None else options
     specs = list(constraints)
     for s in [objective, *specs]:
@@ -408,7 +413,7 @@ def _synthesise(G: GeneralizedPlant, objective, constraints, options, lyapunov_s
             break
         logger.info("msyn: frame round %s -> %s (clean %s)", found[0],
                     None if nxt is None else nxt[0], None if nxt is None else nxt[3])
-        if nxt is None or not nxt[0] < found[0] * (1 - _LEVEL_RELAX):
+        if nxt is None or not nxt[0] < found[0] * (1 - level_relax):
             break
         rounds.append(nxt)
         found = nxt
@@ -440,7 +445,7 @@ def _synthesise(G: GeneralizedPlant, objective, constraints, options, lyapunov_s
     # Sandybridge kernel left a closed-loop pole at +3.6e-12 in the first frame)
     for step in range(_RECONSTRUCTION_STEPS):
         for frame, base, trace in frames:
-            target = base * (1 + _LEVEL_RELAX * 4.0**step) + opts.gamma_atol
+            target = base * (1 + level_relax * 4.0**step) + opts.gamma_atol
             v = form.variables(transform_states(Ps, frame.T), frame.scale)
             box = _TRACE_BOX * 10.0**step * trace
             cons = build(v, target, _SLACK_WEIGHT * t, t)
@@ -460,9 +465,9 @@ def _synthesise(G: GeneralizedPlant, objective, constraints, options, lyapunov_s
             K = sc.controller_to_original(form.controller(v, [objective, *specs]))
             CL = lft(G, K)
             poles = np.linalg.eigvals(np.asarray(CL.A))
-            if not np.all(poles.real < 0):
+            if not _stable(poles, Ps.dt):
                 last = (f"reconstruction at {target:.6g} (scaled): the controller does not "
-                        f"stabilise the plant (max Re pole {np.max(poles.real):.3g})")
+                        f"stabilise the plant (poles {_worst(poles, Ps.dt)})")
                 warnings.append(last)
                 continue
             certs = [_certify(objective, CL, None, unscale(target))]
@@ -496,7 +501,7 @@ def _synthesise(G: GeneralizedPlant, objective, constraints, options, lyapunov_s
         warnings.append(f"the controller was reconstructed at {certs[0].lmi_level:.6g}, "
                         f"{certs[0].lmi_level / lmi_level - 1:.1%} above the LMI optimum "
                         f"{lmi_level:.6g}: the optimum may not be attained (slowest "
-                        f"closed-loop pole {np.max(poles.real):.3g})")
+                        f"closed-loop pole {_worst(poles, Ps.dt)})")
     elif not specs and certs[0].achieved < lmi_level * (1 - _CERT_RTOL):
         # (with constraints the controller's own norm may well be below the level that
         # the common Lyapunov matrix guarantees)
@@ -510,6 +515,17 @@ def _synthesise(G: GeneralizedPlant, objective, constraints, options, lyapunov_s
 
 
 _CHANNEL_SPECS = (HinfBound, H2Bound, PeakBound)
+
+
+def _stable(poles: np.ndarray, dt: float) -> bool:
+    return bool(np.all(np.abs(poles) < 1)) if dt else bool(np.all(poles.real < 0))
+
+
+def _worst(poles: np.ndarray, dt: float) -> str:
+    """The slowest pole, as a figure for a message."""
+    if not poles.size:
+        return "none"
+    return f"max |z| {np.max(np.abs(poles)):.12g}" if dt else f"max Re {np.max(poles.real):.3g}"
 
 
 def _scalable(spec) -> bool:
