@@ -25,9 +25,9 @@ A discrete-time system (sample time ``dt``) is evaluated on the unit circle,
 of its bilinear (Tustin, unwarped) image ``z = (1 + s dt/2) / (1 - s dt/2)``, a
 continuous-time system with the same values on the imaginary axis as the discrete one
 has on the unit circle (``ω_c = (2/dt) tan(ω dt/2)``): the same norm, computed by the
-same iteration, and its peak frequency mapped back.  The realization of the image
-(:func:`_bilinear_image`) keeps ``B`` and ``C`` balanced by ``sqrt(2/dt)`` and needs
-``A + I`` invertible, which every stable discrete system has.
+same iteration, and its peak frequency mapped back.  The image
+(:func:`~lmi_suspension.lti.bilinear.tustin_image`) needs ``A + I`` invertible, which
+every stable discrete system has.
 
 References
 ----------
@@ -48,6 +48,7 @@ import scipy.linalg
 import scipy.optimize
 
 from ..errors import IterationLimitError, ParameterError
+from .bilinear import tustin_frequency, tustin_image
 from .checks import as_statespace, sample_time
 from .scaling import balanced_matrices
 
@@ -363,21 +364,6 @@ def hinfnorm(sys, *, rtol: float = 1e-9, max_iter: int = 100) -> tuple[float, fl
     return _hinfnorm(A, B, C, D, rtol, int(max_iter))
 
 
-def _bilinear_image(A, B, C, D, dt: float):
-    """The continuous-time image of ``(A, B, C, D)`` under ``z = (1 + s dt/2)/(1 - s dt/2)``:
-    ``Ac = a (A + I)⁻¹ (A - I)``, ``Bc = sqrt(2a) (A + I)⁻¹ B``, ``Cc = sqrt(2a) C (A + I)⁻¹``,
-    ``Dc = D - C (A + I)⁻¹ B`` with ``a = 2/dt``; ``Gc(jω_c) = G(exp(jω dt))`` for
-    ``ω_c = a tan(ω dt/2)``.  ``A + I`` must be invertible (no pole at ``z = -1``)."""
-    n = A.shape[0]
-    a = 2.0 / dt
-    lu = scipy.linalg.lu_factor(A + np.eye(n))
-    AiB = scipy.linalg.lu_solve(lu, B)
-    CAi = scipy.linalg.lu_solve(lu, C.T, trans=1).T
-    Ac = a * scipy.linalg.lu_solve(lu, A - np.eye(n))
-    r = np.sqrt(2.0 * a)
-    return Ac, r * AiB, r * CAi, D - C @ AiB
-
-
 def _hinfnorm_discrete(A, B, C, D, dt, rtol, max_iter):
     n = A.shape[0]
     sig_d = float(np.linalg.norm(D, 2)) if D.size else 0.0
@@ -387,10 +373,17 @@ def _hinfnorm_discrete(A, B, C, D, dt, rtol, max_iter):
     if not _stable_poles(poles, dt, STABILITY_TOL):
         worst = poles[np.argmax(np.abs(poles))]
         return float("inf"), float(abs(np.angle(worst)) / dt)
-    Ac, Bc, Cc, Dc = _bilinear_image(A, B, C, D, dt)
+    Ac, Bc, Cc, Dc = (np.asarray(M, dtype=float) for M in _abcd_of(
+        tustin_image(control.ss(A, B, C, D, dt))))
     gamma, wc = _hinfnorm(*balanced_matrices(Ac, Bc, Cc), Dc, rtol, max_iter)
     # ω_c = ∞ is z = -1, the Nyquist rate
-    return gamma, (float(2.0 / dt * np.arctan(wc * dt / 2.0)) if np.isfinite(wc) else np.pi / dt)
+    return gamma, (float(tustin_frequency(wc, dt)) if np.isfinite(wc) else np.pi / dt)
+
+
+def _abcd_of(ss):
+    n = ss.nstates
+    return (np.reshape(ss.A, (n, n)), np.reshape(ss.B, (n, ss.ninputs)),
+            np.reshape(ss.C, (ss.noutputs, n)), np.reshape(ss.D, (ss.noutputs, ss.ninputs)))
 
 
 def _hinfnorm(A, B, C, D, rtol: float, max_iter: int) -> tuple[float, float]:

@@ -36,7 +36,7 @@ import control
 import numpy as np
 
 from ..errors import DimensionError, InfeasibleError, LmiSuspensionError, ParameterError
-from ..lti.checks import as_finite_array
+from ..lti.checks import as_finite_array, sample_time
 from ..lti.norms import freqresp, hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
 from ..lti.scaling import balanced_statespace
@@ -509,7 +509,9 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
     Parameters
     ----------
     P : control.StateSpace, GeneralizedPlant or lmi_suspension.uncertain.USS
-        Generalized plant with inputs ``[w; u]`` and outputs ``[z; y]``; ``w`` and ``z``
+        Generalized plant with inputs ``[w; u]`` and outputs ``[z; y]``, continuous- or
+        discrete-time (a discrete plant is designed on its bilinear image and every
+        result mapped back exactly: :mod:`lmi_suspension.mu.discrete`); ``w`` and ``z``
         hold the uncertainty channels followed by the performance channels, in the order
         of ``blk``.  An uncertain plant (``uss``, inputs ``[d; u]``, outputs
         ``[e; y]``) carries its uncertainty: ``blk`` is then its :func:`lftdata`
@@ -595,6 +597,13 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
     from .steps.fit import default_fit
     from .steps.kstep import GivenFirst, default_kstep
 
+    G_d = _discrete_plant(P, nmeas, ncon)
+    if G_d is not None:
+        from .discrete import musyn_discrete
+
+        return musyn_discrete(musyn, G_d, nmeas, ncon, blk, omega=omega, options=options,
+                              callback=callback, rng=rng, constraints=constraints,
+                              lyapunov_scales=lyapunov_scales, K0=K0, steps=steps)
     t_start = time.perf_counter()
     setup, given = _setup(P, nmeas, ncon, blk, omega, options, rng, constraints,
                           lyapunov_scales, K0)
@@ -788,6 +797,17 @@ def _certified(setup, best, history, stop_reason: str, t_start: float) -> MusynR
         seconds=time.perf_counter() - t_start, omega=omega,
         certificates=certificates(constraints, CL_full), warnings=checks)
 
+
+
+def _discrete_plant(P, nmeas: int, ncon: int) -> GeneralizedPlant | None:
+    """``P`` as a plant when it is a discrete-time system (µ-synthesis then runs on its
+    bilinear image, :mod:`.discrete`), else None."""
+    sys = P.sys if isinstance(P, GeneralizedPlant) else P
+    if not isinstance(sys, (control.StateSpace, control.TransferFunction)):
+        return None  # an uncertain model: continuous time only
+    if not sample_time(sys, "P"):
+        return None
+    return GeneralizedPlant.from_statespace(P, nmeas, ncon, discrete=True)
 
 
 def _setup(P, nmeas, ncon, blk, omega, options, rng, constraints, lyapunov_scales, K0):
