@@ -28,7 +28,8 @@ from lmi_suspension.errors import (DimensionError, DiscreteTimeError, IterationL
                                    NonFiniteError, ParameterError)
 from lmi_suspension.lti import GeneralizedPlant
 from lmi_suspension.tune import (HinfstructOptions, HinfstructResult, block_diagonal,
-                                 hinfstruct, tunable_gain, tunable_pid, tunable_ss)
+                                 hinfstruct, tunable_gain, tunable_pid, tunable_ss,
+                                 tunable_surface)
 
 # the module, not the function of the same name that lmi_suspension.tune exports
 hs = importlib.import_module("lmi_suspension.tune.hinfstruct")
@@ -145,6 +146,11 @@ def _grid_min(P, make_K, boxes, n, *, refine=3, nref=7, keep=3):
     (tunable_ss("C", 3, 2, 1), np.linspace(-1.5, 1.2, 15)),
     (block_diagonal([tunable_pid("C1", "PI"), tunable_ss("C2", 2, 1, 2)]),
      np.linspace(-1.0, 1.0, 13)),
+    (tunable_surface("S", {"a": [0, 1, 2], "b": [1, 2]}, lambda a, b: [a, b * a, b**2],
+                     shape=(2, 1)).at(a=0.5, b=1.5), np.linspace(-1.0, 2.0, 8)),
+    (block_diagonal([tunable_pid("C1", "PI"),
+                     tunable_surface("S", {"a": [0, 1]}, lambda a: [a]).at(a=0.3)]),
+     [0.7, 1.3, -0.4, 2.0]),
 ])
 def test_block_frequency_derivative_matches_central_differences(block, theta):
     theta = np.asarray(theta, dtype=float)
@@ -181,6 +187,25 @@ def test_state_space_block_reaches_real_and_complex_pairs():
     assert sorted(np.real(K.ss(theta).poles())) == pytest.approx([-5.0, -1.0])
     theta[:3] = [-3.0, 2.0, -3.0]                 # -3 ± 2j
     assert sorted(K.ss(theta).poles().tolist(), key=np.imag) == pytest.approx([-3 - 2j, -3 + 2j])
+
+
+def test_gain_surface_is_the_sum_of_its_terms():
+    """K(p) = K0 + a K1 + a b K2 written out by hand, at grid points and off the grid."""
+    S = tunable_surface("S", {"a": [0, 1, 2], "b": [-1, 1]}, lambda a, b: [a, a * b],
+                        shape=(1, 2), fixed={"K2[0,1]": 0.5})
+    assert S.param_names == ("S.K0[0,0]", "S.K0[0,1]", "S.K1[0,0]", "S.K1[0,1]",
+                             "S.K2[0,0]")
+    theta = np.array([1.0, -2.0, 0.5, 3.0, 4.0])
+    K0, K1, K2 = np.array([[1.0, -2.0]]), np.array([[0.5, 3.0]]), np.array([[4.0, 0.5]])
+    for a, b in ((0.0, 1.0), (2.0, -1.0), (0.3, 7.0)):
+        want = K0 + a * K1 + a * b * K2
+        np.testing.assert_allclose(S.gain({"a": a, "b": b}, theta), want, rtol=1e-15)
+        np.testing.assert_allclose(S.at(a=a, b=b).ss(theta).D, want, rtol=1e-15)
+    values = dict(S.values(theta), **{"other.kp": 1.0})    # a result's values
+    np.testing.assert_array_equal(S.gain({"a": 1, "b": 1}, values), S.gain({"a": 1, "b": 1},
+                                                                          theta))
+    # every point shares the same free parameters
+    assert S.at(a=0, b=0).param_names == S.param_names
 
 
 # --------------------------------------------------------------------------- gradient
@@ -464,6 +489,27 @@ def test_no_stabilising_point_is_a_typed_error_or_a_result_that_says_so():
     (lambda: tunable_gain("K", 0, 1), DimensionError),
     (lambda: tunable_ss("K", -1, 1, 1), DimensionError),
     (lambda: HinfstructOptions(on_unstable="ignore"), ParameterError),
+    # gain surfaces: a basis function zero on the grid, one dependent on another or on
+    # the constant, too few grid points, unknown or missing scheduling parameters
+    (lambda: tunable_surface("S", {"a": [1, 2, 3]}, lambda a: [a, 0 * a]), ParameterError),
+    (lambda: tunable_surface("S", {"a": [1, 2, 3]}, lambda a: [a, 3 * a - 1]), ParameterError),
+    (lambda: tunable_surface("S", {"a": [1, 2, 3], "b": [5, 6]}, lambda a, b: [a, b, a + b]),
+     ParameterError),
+    (lambda: tunable_surface("S", {"a": [-1, 1]}, lambda a: [1.0 + 0 * a]), ParameterError),
+    (lambda: tunable_surface("S", {"a": [0, 1]}, lambda a: [a, a**2]), ParameterError),
+    (lambda: tunable_surface("S", {"a": [0, 1]}, lambda a: []), ParameterError),
+    (lambda: tunable_surface("S", {"a": [0, np.nan]}, lambda a: [a]), NonFiniteError),
+    (lambda: tunable_surface("S", {}, lambda a: [a]), ParameterError),
+    (lambda: tunable_surface("S", {"a": [0, 1]}, [1.0]), ParameterError),
+    (lambda: tunable_surface("S", {"a": [0, 1]}, lambda a: [a], shape=(0, 1)), DimensionError),
+    (lambda: tunable_surface("S", {"a": [0, 1]}, lambda a: [a]).at(b=1.0), ParameterError),
+    (lambda: tunable_surface("S", {"a": [0, 1], "b": [0, 1]}, lambda a, b: [a, b]).at(a=1.0),
+     ParameterError),
+    (lambda: tunable_surface("S", {"a": [0, 1]}, lambda a: [a]).at(a=np.inf), NonFiniteError),
+    (lambda: tunable_surface("S", {"a": [0, 1]}, lambda a: [a]).matrices([0.0, 0.0]),
+     ParameterError),
+    (lambda: hinfstruct(plant_a(), tunable_surface("S", {"a": [0, 1]}, lambda a: [a])),
+     ParameterError),
 ])
 def test_bad_input_is_a_typed_error_at_once(call, error):
     t0 = time.perf_counter()

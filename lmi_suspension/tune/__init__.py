@@ -1,5 +1,5 @@
 """Structured H∞ tuning for any plant: tunable blocks (a static gain, a PID, a
-fixed-order state space) and :func:`hinfstruct`, which minimises the closed loop's H∞
+fixed-order state space, a gain surface scheduled on measured parameters) and :func:`hinfstruct`, which minimises the closed loop's H∞
 norm over their parameters by nonsmooth BFGS from several seeded starts, and certifies
 the result with :func:`~lmi_suspension.lti.hinfnorm` as :func:`~lmi_suspension.hinfsyn`
 does.
@@ -10,6 +10,19 @@ neither imports it.
 
 from .blocks import TunableBlock, block_diagonal, tunable_gain, tunable_pid, tunable_ss
 from .hinfstruct import HinfstructOptions, HinfstructResult, StartRecord, hinfstruct
+from .surface import GainSurface, ScheduledBlock, tunable_surface
 
-__all__ = ["tunable_gain", "tunable_pid", "tunable_ss", "hinfstruct", "HinfstructResult",
-           "HinfstructOptions", "StartRecord", "TunableBlock", "block_diagonal"]
+__all__ = [
+           "GainSurface",
+           "HinfstructOptions",
+           "HinfstructResult",
+           "ScheduledBlock",
+           "StartRecord",
+           "TunableBlock",
+           "block_diagonal",
+           "hinfstruct",
+           "tunable_gain",
+           "tunable_pid",
+           "tunable_ss",
+           "tunable_surface",
+]
