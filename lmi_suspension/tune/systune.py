@@ -369,11 +369,11 @@ def _descend(terms, z, budget, opts, state):
         if why not in ("line search ended at a kink", "line search found no decrease"):
             break
         for eps in _ESCAPE:
-            _, d = fg(z, eps)
-            if not np.linalg.norm(d) > 0:
+            _, h = fg(z, eps)                  # least-norm ε-subgradient; -h descends
+            if not np.linalg.norm(h) > 0:
                 why = "stationary (a zero subgradient)"
                 break
-            _, zn, fn, gn = _line_search(fg, z, f, d, -d)
+            _, zn, fn, gn = _line_search(fg, z, f, h, -h)
             if zn is not z and f - fn > opts.ftol * max(abs(f), 1e-12):
                 z, f, g = zn, fn, gn
                 used += 1
@@ -537,7 +537,7 @@ def systune(models, blocks, soft=(), hard=(), *, starts=1,
 
 def _choose(records, opts):
     warnings = []
-    finite = [r for r in records if np.isfinite(r.soft)]
+    finite = [r for r in records if r.soft < np.inf and r.hard < np.inf]   # stabilised
     if not finite:
         best = records[0]
         msg = (f"no start stabilised every model ({len(records)} starts, at most "
@@ -547,8 +547,8 @@ def _choose(records, opts):
         logger.warning(msg)
         return best, [msg]
     feasible = [r for r in finite if r.hard <= 1.0]
-    best = min(feasible, key=lambda r: r.soft) if feasible else min(finite,
-                                                                    key=lambda r: r.hard)
+    best = (min(feasible, key=lambda r: (r.soft, r.hard)) if feasible
+            else min(finite, key=lambda r: r.hard))
     if best.stop == "iteration bound":
         warnings.append(f"the best start (#{best.index}) stopped at its iteration bound "
                         f"({opts.max_iter}): the values may still decrease")
