@@ -764,6 +764,7 @@ def test_systune_hard_margins_hold_on_every_model():
                   options=SystuneOptions(max_iter=30))
     assert res.feasible and np.all(res.hard_values <= 1.0)
     assert res.hard >= 0.99                  # it binds (path-dependent: measured 0.999825)
+    assert all(list(b) == ["C"] and b["C"].nstates == 1 for b in res.blocks)
     w = np.logspace(-4, 4, 20000)
     for G, P, K in zip(Gs, Ps, res.K):
         gm, pm = _classical_margins(K * G, w)
@@ -783,6 +784,7 @@ def test_systune_same_seed_same_result():
     r2 = systune(models, S, soft=HinfBound(), starts=3, rng=np.random.default_rng(5),
                  options=short)
     assert np.array_equal(r1.theta, r2.theta) and r1.soft == r2.soft
+    assert [set(b) for b in r1.blocks] == [{"K"}, {"K"}]
     assert [x.theta0.tolist() for x in r1.starts] == [x.theta0.tolist() for x in r2.starts]
     assert len(r1.starts) == 3 and r1.starts[0].theta0.tolist() == S.start.tolist()
 

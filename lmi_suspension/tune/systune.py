@@ -161,6 +161,9 @@ class SystuneResult:
     K : tuple of control.StateSpace
         The tuned controller of each model (the blocks, block-diagonal, with every gain
         surface at the model's scheduling point).
+    blocks : tuple of dict
+        Per model, each tuned block by name as a :class:`control.StateSpace` (a gain
+        surface at the model's point).
     CL : tuple of control.StateSpace
         ``lft(P_m, K_m)`` of each model.
     soft, hard : float
@@ -185,6 +188,7 @@ class SystuneResult:
     theta: np.ndarray
     K: tuple
     CL: tuple
+    blocks: tuple
     soft: float
     hard: float
     soft_values: np.ndarray
@@ -556,6 +560,14 @@ def _choose(records, opts):
     return best, warnings
 
 
+def _each_block(block, theta) -> dict:
+    """``{name: StateSpace}`` of the blocks that make up ``block`` at ``theta``."""
+    parts = getattr(block, "blocks", None)
+    if parts is None:
+        return {block.name: block.ss(theta)}
+    return {b.name: b.ss(t) for b, t in zip(parts, block._split(theta))}
+
+
 def _certified(plants, model_blocks, soft_b, hard_b, best, records, warnings, t_start,
                opts) -> SystuneResult:
     theta = best.theta
@@ -586,6 +598,7 @@ def _certified(plants, model_blocks, soft_b, hard_b, best, records, warnings, t_
         warnings.append(msg)
     return SystuneResult(
         values=model_blocks[0].values(theta), theta=theta.copy(), K=tuple(Ks), CL=tuple(CLs),
+        blocks=tuple(_each_block(b, theta) for b in model_blocks),
         soft=float(soft_v.max()) if soft_v.size else 0.0, hard=hard,
         soft_values=soft_v, hard_values=hard_v, feasible=feasible, stable=stable,
         starts=tuple(records), best=best.index, seconds=time.perf_counter() - t_start,
