@@ -852,3 +852,15 @@ def test_systune_unstabilisable_returns_a_result_that_says_so():
                   options=SystuneOptions(on_unstable="return"))
     assert not res.stable and not res.feasible
     assert any("no start stabilised" in w for w in res.warnings)
+
+
+def test_systune_on_one_model_agrees_with_hinfstruct():
+    """One model, one soft ‖T‖∞: the problem of hinfstruct, solved by the same BFGS from
+    the same start through systune's terms (another code path: ClosedLoop's gradient,
+    HinfBound's value).  Measured 2026-12-02 (2 starts, PI): plant a -1.4e-10, b +7.2e-9,
+    d +3.2e-11 relative; here plant d, one start."""
+    P = plant_d()
+    h = hinfstruct(P, tunable_pid("C", "PI"))
+    r = systune(P, tunable_pid("C", "PI"), soft=HinfBound())
+    assert r.soft == pytest.approx(h.gamma, rel=1e-6)
+    assert r.soft_values[0, 0] == pytest.approx(hinfnorm(lft(P, r.K[0]))[0], rel=1e-9)
