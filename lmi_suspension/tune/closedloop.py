@@ -50,6 +50,27 @@ class ClosedLoop:
         Numbers of disturbances, errors and controls.
     """
 
+    @classmethod
+    def from_blocks(cls, P, blocks, theta, nmeas: int | None = None,
+                    ncon: int | None = None) -> ClosedLoop:
+        """The loop of plant ``P`` closed by ``blocks`` at ``theta``: to try a
+        requirement of one's own outside :func:`~lmi_suspension.tune.systune`.
+
+        Examples
+        --------
+        >>> import control
+        >>> from lmi_suspension.tune import tunable_gain
+        >>> P = control.ss([[-1.0]], [[1.0, 1.0]], [[1.0], [1.0]], [[0.0, 0.0], [0.0, 0.0]])
+        >>> loop = ClosedLoop.from_blocks(P, tunable_gain("K", 1, 1), [-2.0])
+        >>> loop.poles.real.tolist(), loop.stable                 # -1 + k
+        ([-3.0], True)
+        """
+        from .blocks import block_diagonal
+        from .hinfstruct import _Loop, _plant
+
+        block = block_diagonal(blocks)
+        return cls(_Loop(_plant(P, nmeas, ncon, block), block), theta)
+
     def __init__(self, loop, theta):
         self.theta = np.asarray(theta, dtype=float)
         self.plant = loop.G

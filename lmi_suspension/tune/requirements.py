@@ -257,6 +257,17 @@ class PoleRegion:
     ParameterError
         A negative decay, a damping outside ``[0, 1)``, a non-positive maximum frequency
         or scale.
+
+    Examples
+    --------
+    >>> import control
+    >>> from lmi_suspension.tune import ClosedLoop, tunable_gain
+    >>> P = control.ss([[-1.0]], [[1.0, 1.0]], [[1.0], [1.0]], [[0.0, 0.0], [0.0, 0.0]])
+    >>> loop = ClosedLoop.from_blocks(P, tunable_gain("K", 1, 1), [-2.0])   # pole at -3
+    >>> float(PoleRegion(max_frequency=2.0).value(loop)[0])                # 1 + (3 - 2)/1
+    2.0
+    >>> float(PoleRegion(min_decay=1.0).value(loop)[0])                    # 1 + (-3 + 1)/1
+    -1.0
     """
 
     min_decay: float = 0.0
@@ -335,6 +346,20 @@ class Margins:
     loops : int, str, sequence of them, or None
         The controls (0-based among the plant's ``u``, or their names); ``None`` for all.
     name : str
+
+    Examples
+    --------
+    ``u = -y`` on ``1/(s + 1)``: ``S = (s + 1)/(s + 2)``, ``S - 1/2 = s/(2 (s + 2))``
+    peaks at 1/2 (ω → ∞), a disk margin of 2; 6 dB and 45° ask for
+    ``α = 2 tan(22.5°) = 0.8284``:
+
+    >>> import control
+    >>> from lmi_suspension.tune import ClosedLoop, tunable_gain
+    >>> P = control.ss([[-1.0]], [[1.0, 1.0]], [[1.0], [1.0]], [[0.0, 0.0], [0.0, 0.0]])
+    >>> loop = ClosedLoop.from_blocks(P, tunable_gain("K", 1, 1), [-1.0])
+    >>> req = Margins(6.0, 45.0).bind(loop.plant)
+    >>> round(req.alpha, 4), round(float(req.value(loop)[0]), 4)
+    (0.8284, 0.4142)
     """
 
     gain_margin: float = 6.0
@@ -353,7 +378,8 @@ class Margins:
     def alpha(self) -> float:
         """The disk size the margins ask for."""
         g = 10.0 ** (self.gain_margin / 20.0)
-        return max(2.0 * (g - 1.0) / (g + 1.0), 2.0 * np.tan(np.radians(self.phase_margin) / 2))
+        return float(max(2.0 * (g - 1.0) / (g + 1.0),
+                         2.0 * np.tan(np.radians(self.phase_margin) / 2)))
 
     def bind(self, plant: GeneralizedPlant) -> Margins:
         labels = list(plant.sys.input_labels[plant.nw:])
