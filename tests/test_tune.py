@@ -864,3 +864,17 @@ def test_systune_on_one_model_agrees_with_hinfstruct():
     r = systune(P, tunable_pid("C", "PI"), soft=HinfBound())
     assert r.soft == pytest.approx(h.gamma, rel=1e-6)
     assert r.soft_values[0, 0] == pytest.approx(hinfnorm(lft(P, r.K[0]))[0], rel=1e-9)
+
+
+def test_systune_from_an_infeasible_start_reaches_the_constrained_optimum():
+    """gain_plant(1) with a hard decay of 6 (Re p = -(1 - k) ≤ -6: k ≤ -5): the start
+    k = 0 violates it (decay 1).  ‖T‖∞ = sqrt(1 + k²/4)/(1 - k) rises for k < -4, so the
+    constrained optimum is k = -5, ‖T‖∞ = sqrt(7.25)/6 (closed form)."""
+    P, K = gain_plant(1.0), tunable_gain("K", 1, 1)
+    start = lft(P, K.ss(K.start))
+    assert PoleRegion(min_decay=6.0).certify(start) == pytest.approx(6.0)   # 1 + (-1 + 6)
+    res = systune(P, K, soft=HinfBound(), hard=PoleRegion(min_decay=6.0))
+    assert res.feasible and res.hard <= 1.0
+    assert res.values["K.k"] == pytest.approx(-5.0, rel=1e-5)
+    assert res.soft == pytest.approx(np.sqrt(7.25) / 6, rel=1e-5)
+    assert np.linalg.eigvals(res.CL[0].A).real.max() <= -6.0
