@@ -830,6 +830,8 @@ def test_systune_infeasible_hard_requirement_is_reported(caplog):
      ParameterError),
     (lambda: systune(plant_a(), tunable_pid("C", "PI"), soft=HinfBound(),
                      starts=[[np.nan, 1.0]]), NonFiniteError),
+    (lambda: systune(plant_a(), tunable_pid("C", "PI"), soft=HinfBound(), nmeas=2, ncon=1),
+     DimensionError),
     (lambda: HinfBound(bound=0.0), ParameterError),
     (lambda: PoleRegion(min_damping=1.2), ParameterError),
     (lambda: PoleRegion(min_decay=-1.0), ParameterError),

@@ -454,7 +454,8 @@ def _progress(prob: _Problem, z, opts):
 
 
 # ------------------------------------------------------------------------------ systune
-def systune(models, blocks, soft=(), hard=(), *, starts=1,
+def systune(models, blocks, soft=(), hard=(), *, nmeas: int | None = None,
+            ncon: int | None = None, starts=1,
             rng: np.random.Generator | None = None,
             options: SystuneOptions | None = None) -> SystuneResult:
     """Tune the blocks against soft and hard requirements over several models.
@@ -472,6 +473,9 @@ def systune(models, blocks, soft=(), hard=(), *, starts=1,
     soft, hard : Requirement or sequence of Requirement
         Applied to every model.  ``systune`` minimises the largest soft value subject
         to every hard value ``≤ 1`` (see the module docstring for how).
+    nmeas, ncon : int, optional
+        Numbers of measurements and controls of every plant; by default those of the
+        blocks.
     starts : int or sequence
         As for :func:`~lmi_suspension.tune.hinfstruct`.
     rng : numpy.random.Generator, optional
@@ -526,7 +530,7 @@ def systune(models, blocks, soft=(), hard=(), *, starts=1,
     if not soft_reqs and not hard_reqs:
         raise ParameterError("systune needs at least one soft or hard requirement")
     model_blocks = [_block_at(blocks, point, k) for k, (_, point) in enumerate(items)]
-    plants = [_plant(P, None, None, b) for (P, _), b in zip(items, model_blocks)]
+    plants = [_plant(P, nmeas, ncon, b) for (P, _), b in zip(items, model_blocks)]
     soft_b = [[r.bind(G) for r in soft_reqs] for G in plants]
     hard_b = [[r.bind(G) for r in hard_reqs] for G in plants]
     points = _starts(model_blocks[0], starts, rng, opts)
