@@ -60,7 +60,7 @@ from ..lti.norms import is_stable
 from ..lti.plant import lft
 from .blocks import block_diagonal
 from .closedloop import ClosedLoop
-from .hinfstruct import _bfgs, _line_search, _Loop, _plant, _starts
+from .hinfstruct import _bfgs, _Loop, _plant, _starts
 
 __all__ = ["SystuneOptions", "SystuneResult", "SystuneStart", "systune"]
 
@@ -75,11 +75,10 @@ _HARD_TARGET = 1.0 - 1e-6
 #: infeasibility falls
 _MU = 1.0
 #: terms of a maximum within this (relative) of the largest count as active together
-#: (exact ties, as between mirror-image models, differ by round-off only)
+#: (exact ties, as between mirror-image models, differ by round-off only).  With the
+#: largest term's gradient alone, the docstring's example (models b = ±1, start K = 0)
+#: stopped at its start, 1.0 against 1/√5 = 0.447214 (measured 2026-12-02)
 _TIE = 1e-9
-#: where BFGS stops at a kink, the ε (relative) of the ε-active terms whose least-norm
-#: gradient is tried as a descent direction, widest first
-_ESCAPE = (1e-2, 1e-4, 1e-6)
 
 
 @dataclass(frozen=True)
@@ -355,40 +354,18 @@ def _active_max(terms, n, tie):
 
 def _descend(terms, z, budget, opts, state):
     """Minimise ``max`` of ``terms(z)`` (a list of ``(v, ∇v)``, or ``None`` where
-    undefined): BFGS, and where its line search stops at a kink, one step along the
-    least-norm element of the ε-active terms' gradients (ε in :data:`_ESCAPE`), then
-    BFGS again.  Returns ``(z, f, iterations, why it stopped)``."""
+    undefined) by BFGS from ``z``, ``state`` carrying its inverse Hessian.  Returns
+    ``(z, f, iterations, why it stopped)``."""
     n = z.size
 
-    def fg(y, tie=_TIE):
+    def fg(y):
         t = terms(y)
-        return (np.inf, None) if t is None else _active_max(t, n, tie)
+        return (np.inf, None) if t is None else _active_max(t, n, _TIE)
 
     f, g = fg(z)
-    used, why = 0, "iteration bound"
-    while used < budget:
-        z, f, g, it, why = _bfgs(fg, z, f, g, budget - used, ftol=opts.ftol,
-                                 stall_iter=opts.stall_iter, state=state)
-        used += it
-        if why not in ("line search ended at a kink", "line search found no decrease"):
-            break
-        for eps in _ESCAPE:
-            _, h = fg(z, eps)                  # least-norm ε-subgradient; -h descends
-            if not np.linalg.norm(h) > 0:
-                why = "stationary (a zero subgradient)"
-                break
-            _, zn, fn, gn = _line_search(fg, z, f, h, -h)
-            if zn is not z and f - fn > opts.ftol * max(abs(f), 1e-12):
-                z, f, g = zn, fn, gn
-                used += 1
-                state.clear()                  # the curvature seen so far was the kink's
-                break
-        else:
-            why = f"stationary ({why}; no descent from the ε-active gradients)"
-            break
-        if why.startswith("stationary"):
-            break
-    return z, f, used, why
+    z, f, _, it, why = _bfgs(fg, z, f, g, budget, ftol=opts.ftol,
+                             stall_iter=opts.stall_iter, state=state)
+    return z, f, it, why
 
 
 def _run_start(prob: _Problem, index, theta0, opts, has_soft, has_hard) -> SystuneStart:
@@ -429,7 +406,10 @@ def _progress(prob: _Problem, z, opts):
     """The progress-function outer loop (module docstring).  Returns ``(z, iterations,
     outer iterations, why it stopped)``."""
     used, why = 0, "outer iteration bound"
-    state = {}                          # the inverse Hessian, kept across outer iterations
+    # the inverse Hessian, kept across outer iterations: the test's three-model surface
+    # problem took 101 iterations (658 evaluations) with it, 192 (1303) when each outer
+    # iteration started afresh, to the same optimum (+2.2e-8 and +2.1e-8, 2026-12-02)
+    state = {}
     for outer in range(1, opts.max_outer + 1):
         fk, gk = prob.levels(z)
         gplus = max(gk - _HARD_TARGET, 0.0)
