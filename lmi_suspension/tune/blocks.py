@@ -634,8 +634,8 @@ def block_diagonal(blocks):
     Raises
     ------
     ParameterError
-        An empty sequence, an object that is not a tunable block, or two blocks whose
-        parameters share a name.
+        An empty sequence, an object that is not a tunable block (a gain surface without
+        its scheduling point included), or two blocks whose parameters share a name.
 
     Examples
     --------
@@ -647,6 +647,10 @@ def block_diagonal(blocks):
     if not items:
         raise ParameterError("no tunable block given")
     for b in items:
+        if hasattr(b, "scheduling") and hasattr(b, "at"):
+            raise ParameterError(
+                f"block {getattr(b, 'name', b)!r} depends on a scheduling point: give it "
+                f"one with .at(...), or tune it over models with systune")
         missing = [a for a in _BLOCK_ATTRIBUTES if not hasattr(b, a)]
         if missing:
             raise ParameterError(f"{b!r} is not a tunable block: it lacks {', '.join(missing)}")

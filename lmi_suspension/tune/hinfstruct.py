@@ -485,9 +485,11 @@ def _line_search(fg, x, f, g, d):
             t = 2.0 * lo
 
 
-def _bfgs(fg, x, f, g, max_iter, *, done=None, ftol=0.0, stall_iter=10):
+def _bfgs(fg, x, f, g, max_iter, *, done=None, ftol=0.0, stall_iter=10, state=None):
     """BFGS with the weak Wolfe line search from ``(x, f, g)``; ``done(x, f)`` ends the
-    run early (the stabilisation phase).  Returns ``(x, f, g, iterations, stop)``."""
+    run early (the stabilisation phase).  ``state``, a dict, carries the inverse Hessian
+    from one run to the next (systune's outer loop): read from ``state["H"]`` when there,
+    written back at the end.  Returns ``(x, f, g, iterations, stop)``."""
     n = x.size
     # the first step is at most max(1, |x|) long (HANSO starts from H = I, and a gradient
     # of 1000 then threw a state-space block's C to 1000 and its poles onto the
@@ -495,6 +497,19 @@ def _bfgs(fg, x, f, g, max_iter, *, done=None, ftol=0.0, stall_iter=10):
     H = np.eye(n) * min(1.0, max(1.0, float(np.linalg.norm(x))) / max(float(np.linalg.norm(g)),
                                                                       1e-300))
     scaled = False
+    if state is not None and "H" in state:
+        H, scaled = state["H"], True
+    return _bfgs_loop(fg, x, f, g, max_iter, H, scaled, done, ftol, stall_iter, state)
+
+
+def _bfgs_loop(fg, x, f, g, max_iter, H, scaled, done, ftol, stall_iter, state):
+    n = x.size
+
+    def out(*result):
+        if state is not None:
+            state["H"] = H
+        return result
+
     history = [f]
     for it in range(1, max_iter + 1):
         d = -H @ g
@@ -502,17 +517,17 @@ def _bfgs(fg, x, f, g, max_iter, *, done=None, ftol=0.0, stall_iter=10):
             H = np.eye(n)
             d = -g
             if not g @ d < 0:
-                return x, f, g, it - 1, "zero gradient"
+                return out(x, f, g, it - 1, "zero gradient")
         ok, xn, fn, gn = _line_search(fg, x, f, g, d)
         if xn is x:
-            return x, f, g, it - 1, "line search found no decrease"
+            return out(x, f, g, it - 1, "line search found no decrease")
         s, y = xn - x, gn - g
         x, f, g = xn, fn, gn
         history.append(f)
         if done is not None and done(x, f):
-            return x, f, g, it, "done"
+            return out(x, f, g, it, "done")
         if not ok:
-            return x, f, g, it, "line search ended at a kink"
+            return out(x, f, g, it, "line search ended at a kink")
         sy = float(s @ y)
         if sy > 0:
             if not scaled:                             # Nocedal & Wright (6.20)
@@ -523,8 +538,8 @@ def _bfgs(fg, x, f, g, max_iter, *, done=None, ftol=0.0, stall_iter=10):
             H = V @ H @ V.T + rho * np.outer(s, s)
         if len(history) > stall_iter and \
                 history[-stall_iter - 1] - f <= ftol * abs(f):
-            return x, f, g, it, f"f decreased by less than ftol in {stall_iter} iterations"
-    return x, f, g, max_iter, "iteration bound"
+            return out(x, f, g, it, f"f decreased by less than ftol in {stall_iter} iterations")
+    return out(x, f, g, max_iter, "iteration bound")
 
 
 # ------------------------------------------------------------------------------ inputs
