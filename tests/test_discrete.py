@@ -227,3 +227,21 @@ def test_mixed_dgk_on_a_discrete_plant():
     _assert_discrete_certified(disc, ex.blk, dt)
     assert disc.mu_peak == pytest.approx(cont.mu_peak, rel=5e-3)
     assert disc.mu_peak < 1.131  # below the complexified design (measured 1.1309)
+
+
+@pytest.mark.slow  # 40 s on Zen 1 (2026-12-02, beside other work): the second tier
+def test_discrete_h2hinfsyn_returns_the_certified_norms():
+    # AC4 sampled with a zero-order hold at 50 ms (D22 stays 0): the Pareto point of
+    # ‖T∞‖∞² + ‖T2‖₂² (the H2 channel is z's last row), its norms recomputed here on CL
+    from lmi_suspension.synthesis import h2hinfsyn
+
+    P = compleib("AC4")
+    Pd = control.sample_system(P.sys, 0.05, method="zoh")
+    K, CL, (ginf, g2), info = h2hinfsyn(Pd, P.ny, P.nu, 1, W=(1.0, 1.0))
+    assert K.dt == 0.05 and np.all(np.abs(CL.poles()) < 1)
+    assert ginf == pytest.approx(hinfnorm(CL[0, :])[0], rel=1e-9)
+    assert g2 == pytest.approx(h2norm(CL[1, :]), rel=1e-9)
+    # each norm alone is no better than its own optimum (msyn on that channel alone)
+    from lmi_suspension.synthesis.constraints import Channel
+    alone = msyn(Pd, P.ny, P.nu, HinfBound(Channel(outputs=(0,))))
+    assert ginf >= alone.objective_lmi * (1 - 1e-4)

@@ -150,8 +150,9 @@ def msyn(P, nmeas: int, ncon: int, objective: Specification, constraints=(), *,
     Parameters
     ----------
     P : control.StateSpace or GeneralizedPlant
-        Continuous-time generalized plant (controls last inputs, measurements last
-        outputs); ``D22`` must be zero.
+        Generalized plant (controls last inputs, measurements last outputs), continuous-
+        or discrete-time (see :mod:`.constraints` for the specifications built in
+        discrete time); ``D22`` must be zero.
     nmeas, ncon : int
     objective : HinfBound or H2Bound
         Its ``bound`` is ignored: its level is minimised.
@@ -697,7 +698,8 @@ def h2hinfsyn(P, nmeas: int, ncon: int, nz2: int, W=(1.0, 0.0), *, regions=(),
         Of the last solve (its ``certificates`` hold both norms and the regions).
     """
     G = GeneralizedPlant.from_statespace(
-        P if isinstance(P, GeneralizedPlant) else as_statespace(P, "P"), nmeas, ncon)
+        P if isinstance(P, GeneralizedPlant) else as_statespace(P, "P", discrete=True),
+        nmeas, ncon, discrete=True)
     nz = G.nz
     if not (isinstance(nz2, (int, np.integer)) and 0 < nz2 < nz):
         raise ParameterError(f"nz2 must be between 1 and {nz - 1} (the H∞ channel needs "
