@@ -228,3 +228,121 @@ def test_at_outside_the_range_or_misnamed(linear):
         linear.K.at(mass=2.0)
     with pytest.raises(NonFiniteError):
         linear.K.at(m=np.nan)
+
+
+# ------------------------------------------------------------------- (e) save, export, sample
+def _same_bits(a, b):
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    return a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
+def _same_ss(K1, K2):
+    return all(_same_bits(getattr(K1, M), getattr(K2, M)) for M in "ABCD")
+
+
+def test_json_round_trip_is_exact(linear, tmp_path):
+    """Issue 61 item 3: the saved schedule loads back bit for bit (json writes each
+    float's shortest round-tripping repr), and so does every frozen controller."""
+    from lmi_suspension.io import (controller_from_dict, load_scheduled_controller,
+                                   save_scheduled_controller)
+
+    path = save_scheduled_controller(tmp_path / "K.json", linear, metadata={"note": "msd"})
+    K2, meta = load_scheduled_controller(path)
+    K = linear.K
+    assert meta == {"gamma": linear.gamma, "gamma_lmi": linear.gamma_lmi, "note": "msd"}
+    assert K2.names == K.names and K2.bounds == K.bounds and K2.shape == K.shape
+    assert (K2.nmeas, K2.ncon, K2.backoff) == (K.nmeas, K.ncon, K.backoff)
+    assert K2.gamma_lmi_scaled == K.gamma_lmi_scaled
+    assert all(_same_bits(a, b) for a, b in zip(K2.X + K2.Y, K.X + K.Y))
+    assert all(_same_bits(getattr(K2.scaling, f), getattr(K.scaling, f))
+               for f in ("T", "Su", "Sy", "cw", "cz"))
+    assert _same_bits(K2.grid["m"], K.grid["m"])
+    # the callable plant is stored on the certificate's grid: at each of its nodes the
+    # loaded controller is the original one, bit for bit
+    nodes = linear.check_grid["m"]
+    for m in nodes:
+        assert _same_ss(K2.at(m=m), K.at(m=m))
+    # the frozen controllers on the design grid, readable with the plain controller format
+    import json
+    data = json.loads(path.read_text())
+    assert data["format"] == "lmi_suspension.scheduled_controller/1"
+    assert data["exact_between_nodes"] is False
+    assert len(data["frozen"]) == GRID["m"].size
+    for entry, m in zip(data["frozen"], GRID["m"]):
+        assert entry["metadata"]["p"] == {"m": m}
+        assert _same_ss(controller_from_dict(entry), K.at(m=m))
+
+
+def test_json_round_trip_of_a_table_plant_is_exact_between_nodes(tmp_path):
+    """A plant given as a list and the default basis are stored as they are: the loaded
+    controller equals the original everywhere, between nodes too."""
+    from lmi_suspension.io import load_scheduled_controller, save_scheduled_controller
+
+    res = lpvsyn([(m, msd(m)) for m in (1.0, 2.0, 4.0)], "m", 1, 1)
+    K2, _ = load_scheduled_controller(save_scheduled_controller(tmp_path / "K.json", res.K))
+    for m in (1.0, 1.37, 2.9, 4.0):
+        assert _same_ss(K2.at(m), res.K.at(m))
+
+
+def test_json_round_trip_of_a_callable_basis(tmp_path):
+    """A caller's basis is tabulated: exact at the table's nodes (here a table given)."""
+    from lmi_suspension.errors import InputError
+    from lmi_suspension.io import (load_scheduled_controller, save_scheduled_controller,
+                                   scheduled_from_dict)
+
+    res = lpvsyn(msd, {"m": [1.0, 2.5, 4.0]}, 1, 1, basis=lambda m: [1.0, m, 1.0 / m])
+    table = {"m": [1.0, 1.5, 2.5, 3.1, 4.0]}
+    path = save_scheduled_controller(tmp_path / "K.json", res.K, table=table, frozen=False)
+    K2, _ = load_scheduled_controller(path)
+    for m in table["m"]:
+        assert _same_ss(K2.at(m=m), res.K.at(m=m))
+    with pytest.raises(ParameterError):                     # outside the design interval
+        save_scheduled_controller(tmp_path / "bad.json", res.K, table={"m": [0.5, 2.0]})
+    with pytest.raises(InputError):
+        scheduled_from_dict({"format": "lmi_suspension.controller/1"})
+
+
+def test_mat_export_of_frozen_controllers(linear, tmp_path):
+    """The .mat file holds K(p) on the grid, MATLAB's n x n x N layout, bit for bit."""
+    import scipy.io
+
+    from lmi_suspension.io import save_scheduled_mat
+
+    grid = {"m": linear.check_grid["m"]}
+    m = scipy.io.loadmat(save_scheduled_mat(tmp_path / "K.mat", linear.K, grid))
+    N = grid["m"].size
+    assert m["A"].shape == (2, 2, N) and m["B"].shape == (2, 1, N)
+    assert m["P"].shape == (N, 1) and _same_bits(m["P"][:, 0], grid["m"])
+    assert _same_bits(np.ravel(m["m"]), grid["m"])
+    assert [str(np.ravel(x)[0]) for x in np.ravel(m["ParameterName"])] == ["m"]
+    for k, p in enumerate(grid["m"]):
+        K, level, _ = linear.K.build(m=p)
+        assert all(_same_bits(m[M][:, :, k], getattr(K, M)) for M in "ABCD")
+        assert np.ravel(m["Level"])[k] == level
+    md = scipy.io.loadmat(save_scheduled_mat(tmp_path / "Kd.mat", linear.K, dt=1e-3))
+    assert float(np.ravel(md["Ts"])[0]) == 1e-3 and md["A"].shape[-1] == GRID["m"].size
+    assert _same_bits(md["A"][:, :, 3], linear.K.at_discrete(GRID["m"][3], dt=1e-3).A)
+
+
+def test_discrete_realization_and_nyquist(linear):
+    """Tustin at 1 kHz: Kd(e^{jωT}) = K(j (2/T) tan(ωT/2)) (the bilinear map's warping,
+    evaluated on both systems independently), and a pole above π/dt is a typed error."""
+    from lmi_suspension.errors import NyquistError
+
+    K = linear.K.at(m=2.2)
+    Kd = linear.K.at_discrete(dt=1e-3, m=2.2)
+    assert Kd.dt == 1e-3 and np.all(np.abs(Kd.poles()) < 1.0)
+    T = 1e-3
+    for w in (0.3, 3.0, 30.0, 300.0):
+        zd = complex(Kd(np.exp(1j * w * T)))
+        zc = complex(K(1j * (2.0 / T) * np.tan(w * T / 2.0)))
+        assert zd == pytest.approx(zc, rel=1e-8)
+    fast = float(np.max(np.abs(K.poles())))     # 6.73 rad/s here (measured 2026-12-02)
+    dt = 2.0 * np.pi / fast                                 # Nyquist rate fast / 2
+    with pytest.raises(NyquistError, match="Nyquist"):
+        linear.K.at_discrete(dt=dt, m=2.2)
+    assert isinstance(NyquistError("x"), ParameterError)
+    Kc = linear.K.at_discrete(dt=dt, m=2.2, allow_unresolved=True)
+    assert np.all(np.abs(Kc.poles()) < 1.0)                 # Tustin keeps stability
+    with pytest.raises(ParameterError):
+        linear.K.at_discrete(dt=0.0, m=2.2)

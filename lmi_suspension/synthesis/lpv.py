@@ -51,7 +51,7 @@ import cvxpy as cp
 import numpy as np
 
 from ..errors import (DimensionError, InfeasibleError, InputError, NonFiniteError,
-                      ParameterError, RateBoundNotBuiltError, SolverError)
+                      NyquistError, ParameterError, RateBoundNotBuiltError, SolverError)
 from ..lti.checks import as_statespace, finite_scalar
 from ..lti.norms import hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
@@ -113,33 +113,80 @@ def _axes(grid) -> tuple[tuple[str, ...], tuple[np.ndarray, ...]]:
     return tuple(names), tuple(axes)
 
 
+class _GridTable:
+    """An array-valued function known on a rectangular grid: the stored values exactly
+    at the nodes, their multilinear interpolation in between (axes with one value take
+    no part in it; scipy needs two)."""
+
+    def __init__(self, axes, nodes: dict):
+        import scipy.interpolate
+
+        self.axes = tuple(np.asarray(a, dtype=float) for a in axes)
+        self.nodes = {tuple(float(v) for v in k): np.asarray(m, dtype=float)
+                      for k, m in nodes.items()}
+        first = next(iter(self.nodes.values()))
+        self._live = [i for i, a in enumerate(self.axes) if a.size > 1]
+        data = np.empty(tuple(a.size for a in self.axes) + first.shape)
+        for idx in itertools.product(*(range(a.size) for a in self.axes)):
+            data[idx] = self.nodes[tuple(float(a[i]) for a, i in zip(self.axes, idx))]
+        data = data.reshape(tuple(self.axes[i].size for i in self._live) + first.shape)
+        self._data = data
+        self._interp = None if not self._live else scipy.interpolate.RegularGridInterpolator(
+            tuple(self.axes[i] for i in self._live), data, method="linear")
+
+    def __call__(self, p) -> np.ndarray:
+        # at a node the stored value itself, so a table of a function reproduces it
+        # there bit for bit (the interpolation's weights 1 and 0 need not)
+        hit = self.nodes.get(tuple(float(v) for v in p))
+        if hit is not None:
+            return hit.copy()
+        if self._interp is None:
+            return self._data.copy()
+        return self._interp(np.asarray([p[i] for i in self._live], dtype=float)[None, :])[0]
+
+
 class _TablePlant:
     """A plant known on a rectangular grid, its state-space matrices interpolated
     (multi)linearly in between (LPVTools' convention for gridded systems)."""
 
     def __init__(self, axes, table: dict, shape):
-        import scipy.interpolate
+        self.shape = tuple(shape)
+        self.table = _GridTable(axes, {p: np.block([[sys.A, sys.B], [sys.C, sys.D]])
+                                       for p, sys in table.items()})
 
-        self.shape = shape
-        # axes with one value take no part in the interpolation (scipy needs two)
-        self._live = [i for i, a in enumerate(axes) if a.size > 1]
-        n, m, q = shape
-        data = np.empty(tuple(a.size for a in axes) + (n + q, n + m))
-        for idx in itertools.product(*(range(a.size) for a in axes)):
-            sys = table[tuple(float(a[i]) for a, i in zip(axes, idx))]
-            data[idx] = np.block([[sys.A, sys.B], [sys.C, sys.D]])
-        data = data.reshape(tuple(axes[i].size for i in self._live) + data.shape[-2:])
-        self._interp = None if not self._live else scipy.interpolate.RegularGridInterpolator(
-            tuple(axes[i] for i in self._live), data, method="linear")
-        self._data = data
+    @classmethod
+    def from_blocks(cls, axes, blocks: dict, shape) -> _TablePlant:
+        """From ``{p: [[A, B], [C, D]]}`` (a saved table)."""
+        self = cls.__new__(cls)
+        self.shape = tuple(shape)
+        self.table = _GridTable(axes, blocks)
+        return self
 
     def __call__(self, *p):
         n = self.shape[0]
-        if self._interp is None:
-            M = self._data
-        else:
-            M = self._interp(np.asarray([p[i] for i in self._live], dtype=float)[None, :])[0]
+        M = self.table(p)
         return control.ss(M[:n, :n], M[:n, n:], M[n:, :n], M[n:, n:])
+
+
+class _AffineBasis:
+    """The default basis ``[1]`` and each parameter that takes more than one grid value
+    (a class, not a closure, so a saved controller can name it)."""
+
+    def __init__(self, live):
+        self.live = tuple(int(i) for i in live)
+
+    def __call__(self, *p):
+        return [1.0] + [p[i] for i in self.live]
+
+
+class _TableBasis:
+    """A basis known on a grid (a loaded controller's), interpolated in between."""
+
+    def __init__(self, table: _GridTable):
+        self.table = table
+
+    def __call__(self, *p):
+        return self.table(p)
 
 
 def _from_pairs(pairs, grid):
@@ -190,8 +237,7 @@ def _from_pairs(pairs, grid):
 
 def _default_basis(axes):
     """``[1]`` and each parameter that takes more than one value on the grid."""
-    live = [i for i, a in enumerate(axes) if a.size > 1]
-    return lambda *p: [1.0] + [p[i] for i in live]
+    return _AffineBasis(i for i, a in enumerate(axes) if a.size > 1)
 
 
 def _basis_values(basis, p, nb: int | None) -> np.ndarray:
@@ -230,6 +276,11 @@ def _apply_scaling(G: GeneralizedPlant, sc: PlantScaling) -> GeneralizedPlant:
         Ti[:, None] * b["B2"] * Su[None, :], b["C1"] * T[None, :] / cz,
         Sy[:, None] * b["C2"] * T[None, :], b["D11"] * (cw / cz), b["D12"] * Su[None, :] / cz,
         Sy[:, None] * b["D21"] * cw, np.zeros_like(b["D22"]))
+
+
+def _floats(M):
+    """A numpy array as nested lists of Python floats (json writes them exactly)."""
+    return np.asarray(M, dtype=float).tolist()
 
 
 # --------------------------------------------------------------------------- controller
@@ -276,6 +327,7 @@ class ScheduledController:
     nmeas: int
     ncon: int
     shape: tuple = field(repr=False, default=None)
+    grid: dict = field(repr=False, default=None)
 
     def values(self, *args, **named) -> tuple:
         """The parameter values as a tuple in the order of ``names`` (checked)."""
@@ -345,6 +397,156 @@ class ScheduledController:
     def at(self, *args, **named) -> control.StateSpace:
         """The controller at one parameter value (``K.at(m3=42.0)``)."""
         return self.build(*args, **named)[0]
+
+    def at_discrete(self, *args, dt: float, allow_unresolved: bool = False,
+                    **named) -> control.StateSpace:
+        """The controller at one parameter value, discretised by Tustin's bilinear map at
+        the sample time ``dt`` (s): ``K.at_discrete(dt=1e-3, m3=42.0)``.
+
+        Tustin (python-control's ``sample_system``, method ``"bilinear"``) maps the left
+        half-plane onto the unit disk, so the stable frozen controllers stay stable at
+        any rate, and keeps the frequency response up to the warping
+        ``ω -> (2/dt) tan(ω dt / 2)``.  A controller pole above the Nyquist rate ``π/dt``
+        is compressed below it: the discrete controller is then a different one, and the
+        certified γ says nothing about it.  That is a :class:`NyquistError`, not a
+        warning: a realization for a computer is asked for exactly once per schedule
+        point, nobody reads a log at that moment, and the error names the pole and the
+        rate needed (``allow_unresolved=True`` returns the compressed realization
+        anyway).  ``BACKOFF`` keeps the poles of :func:`lpvsyn`'s controllers below
+        1e3 rad/s on the examples measured, a third of the 1 kHz Nyquist rate.
+
+        Raises
+        ------
+        NyquistError
+            A pole of ``K(p)`` faster than ``π/dt`` (without ``allow_unresolved``).
+        ParameterError
+            ``dt`` not positive, or a parameter value outside the design interval.
+        """
+        dt = finite_scalar(dt, "dt")
+        if dt <= 0:
+            raise ParameterError(f"dt must be a positive number of seconds, got {dt!r}")
+        K = self.at(*args, **named)
+        fast = float(np.max(np.abs(np.linalg.eigvals(K.A)))) if K.nstates else 0.0
+        if fast > np.pi / dt and not allow_unresolved:
+            p = self.values(*args, **named)
+            where = ", ".join(f"{n}={v:.6g}" for n, v in zip(self.names, p))
+            raise NyquistError(f"at {where} the controller has a pole at {fast:.6g} rad/s, "
+                               f"above the Nyquist rate π/dt = {np.pi / dt:.6g} rad/s: "
+                               f"sample faster than dt = {np.pi / fast:.3g} s (or pass "
+                               "allow_unresolved=True)")
+        Kd = control.sample_system(K, dt, method="bilinear")
+        return control.ss(Kd.A, Kd.B, Kd.C, Kd.D, dt)
+
+    def to_dict(self, table: dict | None = None) -> dict:
+        """JSON-ready description (every float a Python float, which :mod:`json` writes
+        as its shortest round-tripping repr: loading is exact).
+
+        The plant and a caller's basis are callables; they are stored as tables on
+        ``table`` (``{name: values}``), by default the plant's own table when it was
+        given as a list of plants, else the design grid cut 4 times finer (the
+        certificate's grid).  :meth:`from_dict` reproduces ``X_i``, ``Y_i``, the
+        scalings and every table bit for bit, so ``at(p)`` of the loaded controller
+        equals the original's bit for bit at every table node; between nodes the loaded
+        controller uses the tables' linear interpolation (exact everywhere when the
+        plant was a list of plants and the basis the default, ``"exact_between_nodes"``).
+        """
+        plant_is_table = isinstance(self.plant, _TablePlant) and table is None
+        if table is not None:
+            names, axes = _axes(table)
+            if names != self.names:
+                raise ParameterError(f"the table's parameters {names} are not {self.names}")
+            # every node inside the design interval (the axes are sorted)
+            self.values(*(float(a[0]) for a in axes))
+            self.values(*(float(a[-1]) for a in axes))
+        elif plant_is_table:
+            axes = self.plant.table.axes
+        elif self.grid is not None:
+            axes = tuple(_check_axes(tuple(np.asarray(self.grid[n], dtype=float)
+                                           for n in self.names), 4))
+        else:
+            raise ParameterError("give the table {name: values} the plant is stored on")
+        nodes = list(itertools.product(*(a.tolist() for a in axes)))
+        if plant_is_table:
+            blocks = [self.plant.table.nodes[p] for p in nodes]
+        else:
+            blocks = []
+            for p in nodes:
+                G = as_statespace(self.plant(*p), f"P{p}")
+                if (G.nstates, G.ninputs, G.noutputs) != tuple(self.shape):
+                    raise DimensionError(f"P{p} does not have the sizes {self.shape}")
+                blocks.append(np.block([[G.A, G.B], [G.C, G.D]]))
+        if isinstance(self.basis, _AffineBasis):
+            basis = {"kind": "affine", "live": list(self.basis.live)}
+        elif isinstance(self.basis, _TableBasis) and table is None:
+            b_axes = self.basis.table.axes
+            basis = {"kind": "table", "axes": [_floats(a) for a in b_axes],
+                     "values": [_floats(self.basis.table.nodes[p]) for p in
+                                itertools.product(*(a.tolist() for a in b_axes))]}
+        else:
+            basis = {"kind": "table", "axes": [_floats(a) for a in axes],
+                     "values": [_floats(_basis_values(self.basis, p, len(self.X)))
+                                for p in nodes]}
+        sc = self.scaling
+        return {
+            "names": list(self.names),
+            "bounds": [[float(lo), float(hi)] for lo, hi in self.bounds],
+            "nmeas": int(self.nmeas), "ncon": int(self.ncon),
+            "shape": [int(v) for v in self.shape],
+            "grid": None if self.grid is None else
+            {n: _floats(self.grid[n]) for n in self.names},
+            "X": [_floats(M) for M in self.X], "Y": [_floats(M) for M in self.Y],
+            "gamma_lmi_scaled": float(self.gamma_lmi_scaled), "backoff": float(self.backoff),
+            "scaling": {"T": _floats(sc.T), "Su": _floats(sc.Su), "Sy": _floats(sc.Sy),
+                        "cw": float(sc.cw), "cz": float(sc.cz)},
+            "plant": {"axes": [_floats(a) for a in axes],
+                      "blocks": [_floats(M) for M in blocks]},
+            "basis": basis,
+            "exact_between_nodes": bool(plant_is_table and (
+                basis["kind"] == "affine" or isinstance(self.basis, _TableBasis))),
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> ScheduledController:
+        """The controller described by :meth:`to_dict` (exactly)."""
+        try:
+            names = tuple(str(n) for n in data["names"])
+            shape = tuple(int(v) for v in data["shape"])
+            plant_axes = [np.asarray(a, dtype=float) for a in data["plant"]["axes"]]
+            nodes = list(itertools.product(*(a.tolist() for a in plant_axes)))
+            blocks = data["plant"]["blocks"]
+            if len(blocks) != len(nodes):
+                raise DimensionError(f"the plant table has {len(blocks)} entries for "
+                                     f"{len(nodes)} nodes")
+            plant = _TablePlant.from_blocks(plant_axes, dict(zip(nodes, blocks)), shape)
+            b = data["basis"]
+            if b["kind"] == "affine":
+                basis = _AffineBasis(b["live"])
+            elif b["kind"] == "table":
+                b_axes = [np.asarray(a, dtype=float) for a in b["axes"]]
+                b_nodes = list(itertools.product(*(a.tolist() for a in b_axes)))
+                if len(b["values"]) != len(b_nodes):
+                    raise DimensionError("the basis table does not match its axes")
+                basis = _TableBasis(_GridTable(b_axes, dict(zip(b_nodes, b["values"]))))
+            else:
+                raise InputError(f"unknown basis kind {b['kind']!r}")
+            sc = data["scaling"]
+            scaling = PlantScaling(np.asarray(sc["T"], dtype=float),
+                                   np.asarray(sc["Su"], dtype=float),
+                                   np.asarray(sc["Sy"], dtype=float),
+                                   float(sc["cw"]), float(sc["cz"]))
+            X = tuple(np.asarray(M, dtype=float) for M in data["X"])
+            Y = tuple(np.asarray(M, dtype=float) for M in data["Y"])
+            grid = None if data.get("grid") is None else \
+                {n: np.asarray(data["grid"][n], dtype=float) for n in names}
+            return cls(names, tuple((float(lo), float(hi)) for lo, hi in data["bounds"]),
+                       basis, X, Y, float(data["gamma_lmi_scaled"]), float(data["backoff"]),
+                       scaling, plant, int(data["nmeas"]), int(data["ncon"]), shape, grid)
+        except KeyError as exc:
+            raise InputError(f"scheduled controller description lacks key {exc}") from exc
+        except (TypeError, ValueError) as exc:
+            if isinstance(exc, InputError):
+                raise
+            raise InputError(f"malformed scheduled controller description: {exc}") from exc
 
 
 # --------------------------------------------------------------------------- result
@@ -575,7 +777,7 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
     t_lmi = time.perf_counter() - t1
     K = ScheduledController(tuple(names), tuple((float(a[0]), float(a[-1])) for a in axes),
                             basis, Xi, Yi, g_s, backoff, sc, plant, int(nmeas), int(ncon),
-                            shape)
+                            shape, dict(zip(names, axes)))
     gamma_lmi = g_s / sc.gamma_factor
     t2 = time.perf_counter()
     check = _check_axes(axes, int(check_density))
