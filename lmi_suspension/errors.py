@@ -20,7 +20,7 @@ __all__ = [
     "SolverError",
     "IterationLimitError",
     "NotBuiltError",
-    "RateBoundNotBuiltError",
+    "NyquistError",
 ]
 
 
@@ -84,11 +84,6 @@ class IterationLimitError(LmiSuspensionError):
 class NotBuiltError(LmiSuspensionError, NotImplementedError):
     """A documented capability that is not built yet; the message says which, and what
     works instead."""
-
-
-class RateBoundNotBuiltError(NotBuiltError):
-    """:func:`~lmi_suspension.lpv.lpvsyn` was asked for a nonzero rate bound ν: only
-    parameters frozen during operation (ν = 0) are built."""
 
 
 class NyquistError(ParameterError):

@@ -16,7 +16,7 @@ import pytest
 
 from lmi_suspension.errors import (DimensionError, DiscreteTimeError, LmiSuspensionError,
                                    NonFiniteError, ParameterError)
-from lmi_suspension.lpv import LpvsynResult, RateBoundNotBuiltError, ScheduledController, lpvsyn
+from lmi_suspension.lpv import LpvsynResult, ScheduledController, lpvsyn
 from lmi_suspension.lti import lft
 from lmi_suspension.synthesis import hinfsyn
 
@@ -196,7 +196,9 @@ def _discrete(m):
 
 
 @pytest.mark.parametrize("kwargs, err", [
-    (dict(rate={"m": 0.1}), RateBoundNotBuiltError),
+    (dict(grid={"m": [2.0]}, rate={"m": 0.1}), ParameterError),   # rate on one value
+    (dict(rate={"m": np.inf}), NonFiniteError),
+    (dict(rate={"m": -0.1}), ParameterError),
     (dict(grid={"m": [1.0, np.nan, 4.0]}), NonFiniteError),
     (dict(grid={"m": []}), ParameterError),
     (dict(grid={}), ParameterError),
@@ -216,9 +218,7 @@ def test_typed_errors(kwargs, err):
     with pytest.raises(err) as info:
         lpvsyn(args["P"], args["grid"], 1, 1, basis=args["basis"], rate=args["rate"])
     assert isinstance(info.value, LmiSuspensionError)
-    assert time.perf_counter() - t < 2.0
-    if err is RateBoundNotBuiltError:
-        assert isinstance(info.value, NotImplementedError) and "ν > 0" in str(info.value)
+    assert time.perf_counter() - t < 1.0                    # issue 61: under a second
 
 
 def test_at_outside_the_range_or_misnamed(linear):
@@ -346,3 +346,114 @@ def test_discrete_realization_and_nyquist(linear):
     assert np.all(np.abs(Kc.poles()) < 1.0)                 # Tustin keeps stability
     with pytest.raises(ParameterError):
         linear.K.at_discrete(dt=0.0, m=2.2)
+
+
+# ------------------------------------------------------------------- (f) rate bounds
+NU = 0.5            # |dm/dt| <= 0.5 kg/s: the mass can sweep its range in 6 s
+
+
+@pytest.fixture(scope="module")
+def rated():
+    return lpvsyn(msd, GRID, 1, 1, rate={"m": NU})            # both forms tried
+
+
+def _scaled_loop(K, m):
+    """The closed loop of msd(m) and K(m) (python-control's interconnection of the
+    returned controller), in the scaled plant's coordinates and signals."""
+    Kp, level, _ = K.build(m=m)
+    CL = lft(msd(m), Kp)
+    sc = K.scaling
+    J = np.diag(np.r_[sc.T, np.ones(CL.nstates - sc.T.size)])
+    A = np.linalg.solve(J, CL.A @ J)
+    B = np.linalg.solve(J, CL.B) * sc.cw
+    return A, B, CL.C @ J / sc.cz, CL.D * sc.cw / sc.cz, level
+
+
+def _lpv_brl(K, m, pdot_values, h=1e-6):
+    """Largest eigenvalue of the closed loop's bounded-real inequality with Ṗ = ṗ ∂P/∂m
+    (central differences of the returned Lyapunov matrix) at each ṗ: a second route to
+    the rate-bounded guarantee, from the closed loop rather than the projected LMIs."""
+    A, B, C, D, level = _scaled_loop(K, m)
+    g = level * K.scaling.gamma_factor
+    P = K.closed_loop_lyapunov(m=m, level=level)
+    lo, hi = max(1.0, m - h), min(4.0, m + h)
+    dP = (K.closed_loop_lyapunov(m=hi, level=level)
+          - K.closed_loop_lyapunov(m=lo, level=level)) / (hi - lo)
+    assert np.linalg.eigvalsh(P)[0] > 0.0
+    out = []
+    for pd in pdot_values:
+        L = np.block([[A.T @ P + P @ A + pd * dP, P @ B, C.T],
+                      [B.T @ P, -g * np.eye(B.shape[1]), D.T],
+                      [C, D, -g * np.eye(C.shape[0])]])
+        out.append(float(np.linalg.eigvalsh((L + L.T) / 2)[-1]))
+    return max(out)
+
+
+def test_rate_bounded_certificates(rated, linear):
+    """ν > 0 (issue 61 items 1 and 4(b)): the parameter-dependent inequalities with the
+    ∂X/∂p terms hold at every vertex on the dense grid, every frozen loop is certified,
+    and the closed loop's own LPV bounded-real inequality holds with Ṗ at ṗ = ±ν."""
+    res = rated
+    assert res.K.rate_bounded and res.K.rate == (NU,) and res.K.rate_form in ("X", "Y")
+    assert res.warnings == ()
+    assert res.notes and "kept" in res.notes[0]              # both forms were solved
+    assert res.inequality_check.shape == res.gamma_check.shape
+    assert np.all(res.inequality_check < 0.0)                # certificate (b)
+    assert np.all(np.isfinite(res.gamma_check))
+    assert res.gamma <= np.max(res.levels) * (1.0 + 1e-6)    # certificate (a)
+    # the frozen design relaxes the rate-bounded one: its optimum is no higher
+    # (measured 2026-12-02: 0.3119 against 0.4768, see the module docstring of lpv.py)
+    assert linear.gamma_lmi <= res.gamma_lmi * (1.0 + 1e-6)
+    # second route: at design points and between them (measured 2026-12-02: largest
+    # eigenvalues -1e-4 to -4e-3 of γ ≈ 0.49 in scaled units)
+    for m in (1.0, 1.2, 2.2, 3.3, 4.0):
+        assert _lpv_brl(res.K, m, (-NU, 0.0, NU)) < 0.0
+
+
+def test_rate_bound_certificate_fails_by_injection(rated):
+    """Certificate (b) must be able to fail: the same controller re-evaluated for a
+    rate bound 1e4 times larger."""
+    import dataclasses
+
+    fast = dataclasses.replace(rated.K, rate=(NU * 1e4,))
+    worst = max(fast.inequalities(m=m, level=lv)
+                for m, lv in zip(rated.check_grid["m"], rated.levels))
+    assert worst > 0.0
+
+
+@pytest.mark.parametrize("form", ["X", "Y"])
+def test_rate_forms_and_monotone_in_the_rate(form):
+    """Each form on its own; a larger rate bound cannot lower the optimum (the feasible
+    set shrinks); the controller does not depend on ṗ (the same at every call)."""
+    grid = {"m": [1.0, 2.5, 4.0]}
+    slow = lpvsyn(msd, grid, 1, 1, rate={"m": 0.05}, rate_form=form)
+    quick = lpvsyn(msd, grid, 1, 1, rate={"m": 50.0}, rate_form=form)
+    assert slow.K.rate_form == quick.K.rate_form == form
+    assert slow.gamma_lmi <= quick.gamma_lmi * (1.0 + 1e-5)   # Clarabel's tolerance
+    for res, nu in ((slow, 0.05), (quick, 50.0)):
+        assert res.warnings == () and np.all(res.inequality_check < 0.0)
+        assert _lpv_brl(res.K, 1.7, (-nu, nu)) < 0.0
+    assert _same_ss(slow.K.at(m=1.7), slow.K.at(m=1.7))
+
+
+def test_rate_bounded_round_trip_with_a_callable_basis(tmp_path):
+    """A rate-bounded schedule with a caller's basis: the basis and its Jacobian are
+    tabulated; at the nodes the loaded controller is the original bit for bit."""
+    from lmi_suspension.io import load_scheduled_controller, save_scheduled_controller
+
+    res = lpvsyn(msd, {"m": [1.0, 2.5, 4.0]}, 1, 1, basis=lambda m: [1.0, 1.0 / m],
+                 rate={"m": 0.2}, rate_form="Y")
+    K2, _ = load_scheduled_controller(save_scheduled_controller(tmp_path / "K.json", res.K))
+    assert K2.rate == res.K.rate and K2.rate_form == "Y"
+    assert _same_bits(K2.frame, res.K.frame)
+    for m in res.check_grid["m"]:
+        assert _same_ss(K2.at(m=m), res.K.at(m=m))
+    assert all(_same_bits(a, b) for a, b in zip(K2.lyapunov_rate(m=2.5),
+                                                  res.K.lyapunov_rate(m=2.5)))
+    # the basis derivative (complex step) against the formula d(1/m)/dm = -1/m²
+    from lmi_suspension.synthesis.lpv import _basis_jacobian
+    assert np.allclose(_basis_jacobian(lambda m: [1.0, 1.0 / m], (2.5,), 2)[:, 0],
+                       [0.0, -1.0 / 2.5**2], rtol=1e-14, atol=0.0)
+    # a basis that refuses complex numbers falls back to central differences
+    J = _basis_jacobian(lambda m: [1.0, 1.0 / float(m)], (2.5,), 2)
+    assert J[1, 0] == pytest.approx(-1.0 / 2.5**2, rel=1e-8)

@@ -1,5 +1,5 @@
-"""Gridded gain-scheduled H∞ output-feedback synthesis (:func:`lpvsyn`), parameters frozen
-during operation (rate bound ν = 0).
+"""Gridded gain-scheduled H∞ output-feedback synthesis (:func:`lpvsyn`), for parameters
+frozen during operation (rate bound ν = 0) or varying at bounded rates ``|ṗ_k| <= ν_k``.
 
 The plant ``P(p)`` is given on a grid of a measured parameter vector ``p`` (a callable
 ``p -> StateSpace``, or a list of ``(p, plant)`` pairs whose matrices are interpolated
@@ -19,8 +19,23 @@ settings of :mod:`.lmi`).  With ν = 0 the Lyapunov inequalities carry no ``∂X
 term (Wu et al. 1996, Apkarian & Adams 1998 with a zero rate bound): the controller is
 guaranteed **for frozen parameters** — for each constant ``p`` the loop is stable with
 ``‖F_l(P(p), K(p))‖∞`` below the level — and nothing is claimed for a ``p`` that moves
-during operation; slowly varying parameters need ν > 0, which is not built yet
-(:class:`RateBoundNotBuiltError`).
+during operation.
+
+With a rate bound ν > 0 (Wu et al. 1996; Apkarian & Adams 1998) the ``X`` inequality
+carries ``-Ẋ = -Σ_k ṗ_k ∂X/∂p_k`` (the ``Y`` one ``+Ẏ``) in its state block, imposed at
+every vertex ``ṗ_k = ±ν_k`` of the rate box at every grid point.  With both matrices
+parameter dependent the controller would need ``ṗ`` (LPVTools' ``lpvsyn`` returns such
+a controller); here one of them is constant (``rate_form``: ``"X"`` makes ``X(p)``
+dependent and ``Y`` constant, ``"Y"`` the converse, ``"auto"`` solves both and keeps
+the lower γ), so that with controller coordinates fixed over the range the derivative
+term in the controller's ``Â`` block vanishes and ``K(p)`` depends on ``p`` only
+(Apkarian & Adams 1998, §3).  The price is measured in ``tests/test_lpv.py``: on its
+mass-spring-damper the ``ṗ``-free forms reach γ_lmi 0.477, about what a constant pair
+reaches (0.4775), against 0.312 for frozen parameters with the same basis.  The
+closed loop then satisfies the bounded-real inequality with ``Ṗ`` at every vertex for
+the Lyapunov matrix :meth:`ScheduledController.closed_loop_lyapunov`: its induced
+L2 gain is below the level for every trajectory ``p(t)`` in the range with
+``|ṗ_k| <= ν_k`` — where the inequalities hold, which is checked on the dense grid.
 
 The scheduled controller is formed at any ``p`` (between grid points too) from
 ``X(p)``, ``Y(p)`` and ``P(p)`` by the project's explicit formulas
@@ -46,12 +61,14 @@ import time
 from dataclasses import dataclass, field
 from typing import Callable
 
+import logging
+
 import control
 import cvxpy as cp
 import numpy as np
 
 from ..errors import (DimensionError, InfeasibleError, InputError, NonFiniteError,
-                      NyquistError, ParameterError, RateBoundNotBuiltError, SolverError)
+                      NyquistError, ParameterError, SolverError)
 from ..lti.checks import as_statespace, finite_scalar
 from ..lti.norms import hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
@@ -60,7 +77,9 @@ from . import lmi as _lmi
 from .hinfsyn import _undo_loop_shift, _without_d22
 from .result import HinfsynOptions
 
-__all__ = ["lpvsyn", "LpvsynResult", "ScheduledController", "RateBoundNotBuiltError"]
+__all__ = ["lpvsyn", "LpvsynResult", "ScheduledController"]
+
+logger = logging.getLogger(__name__)
 
 #: default back-off of the reconstruction level above the LMI optimum (relative).  The
 #: explicit formulas at ``(1 + r) γ_lmi`` with ``(X, Y)`` scaled by ``sqrt(1 + r)`` have
@@ -178,15 +197,29 @@ class _AffineBasis:
     def __call__(self, *p):
         return [1.0] + [p[i] for i in self.live]
 
+    def jacobian(self, *p) -> np.ndarray:
+        """``∂f_i/∂p_k`` (exact)."""
+        J = np.zeros((1 + len(self.live), len(p)))
+        for r, i in enumerate(self.live):
+            J[1 + r, i] = 1.0
+        return J
+
 
 class _TableBasis:
-    """A basis known on a grid (a loaded controller's), interpolated in between."""
+    """A basis known on a grid (a loaded controller's), interpolated in between, with
+    its Jacobian where the saved controller is rate bounded."""
 
-    def __init__(self, table: _GridTable):
+    def __init__(self, table: _GridTable, jac: _GridTable | None = None):
         self.table = table
+        self.jac = jac
 
     def __call__(self, *p):
         return self.table(p)
+
+    def jacobian(self, *p) -> np.ndarray:
+        if self.jac is None:
+            raise InputError("this saved basis has no Jacobian (saved without a rate bound)")
+        return self.jac(p)
 
 
 def _from_pairs(pairs, grid):
@@ -255,6 +288,56 @@ def _basis_values(basis, p, nb: int | None) -> np.ndarray:
     return f
 
 
+#: complex step of the basis derivative (relative to max(1, |p_k|)): exact to roundoff
+#: for any basis written with arithmetic and numpy functions (Squire & Trapp 1998)
+_COMPLEX_STEP = 1e-30
+#: central-difference step (relative) where the basis does not take complex values, and
+#: the tolerance within which the complex step must agree with it
+_FD_STEP = 1e-6
+_FD_RTOL = 1e-5
+
+
+def _basis_jacobian(basis, p, nb: int) -> np.ndarray:
+    """``J[i, k] = ∂f_i/∂p_k`` at ``p``: the basis's own ``jacobian`` where it has one,
+    else by complex step, checked against central differences (used alone where the
+    callable refuses complex numbers)."""
+    if hasattr(basis, "jacobian"):
+        return np.asarray(basis.jacobian(*p), dtype=float).reshape(nb, len(p))
+    J = np.empty((nb, len(p)))
+    for k in range(len(p)):
+        h = _FD_STEP * max(1.0, abs(p[k]))
+        hi = tuple(v + (h if i == k else 0.0) for i, v in enumerate(p))
+        lo = tuple(v - (h if i == k else 0.0) for i, v in enumerate(p))
+        fd = (_basis_values(basis, hi, nb) - _basis_values(basis, lo, nb)) / (2 * h)
+        try:
+            hc = _COMPLEX_STEP * max(1.0, abs(p[k]))
+            pc = tuple(complex(v, hc if i == k else 0.0) for i, v in enumerate(p))
+            cs = np.asarray(basis(*pc), dtype=complex).ravel().imag / hc
+        except (TypeError, ValueError):
+            cs = None
+        if cs is not None and cs.size == nb and np.all(np.isfinite(cs)) and np.allclose(
+                cs, fd, rtol=_FD_RTOL, atol=_FD_RTOL * max(1.0, np.abs(fd).max())):
+            J[:, k] = cs
+        else:
+            logger.info("basis derivative by central differences at p = %s", p)
+            J[:, k] = fd
+    if not np.all(np.isfinite(J)):
+        raise NonFiniteError(f"the basis derivative is not finite at p = {p}")
+    return J
+
+
+def _vertices(nus) -> list[np.ndarray]:
+    """The corners of the rate box ``|ṗ_k| <= ν_k`` (parameters with ν_k = 0 fixed at 0)."""
+    live = [k for k, nu in enumerate(nus) if nu > 0]
+    out = []
+    for signs in itertools.product((-1.0, 1.0), repeat=len(live)):
+        v = np.zeros(len(nus))
+        for k, sg in zip(live, signs):
+            v[k] = sg * nus[k]
+        out.append(v)
+    return out
+
+
 def _plant_at(plant, p, nmeas, ncon, shape=None) -> GeneralizedPlant:
     sys = as_statespace(plant(*p), f"P{p}")
     s = (sys.nstates, sys.ninputs, sys.noutputs)
@@ -286,7 +369,7 @@ def _floats(M):
 # --------------------------------------------------------------------------- controller
 @dataclass(frozen=True)
 class ScheduledController:
-    """A controller scheduled on a measured parameter, frozen-parameter (ν = 0) design.
+    """A controller scheduled on a measured parameter (frozen or rate-bounded design).
 
     ``K.at(m3=42.0)`` (or ``K.at(42.0)`` for one parameter) is the controller at that
     value: the explicit formulas of
@@ -313,6 +396,19 @@ class ScheduledController:
     plant : callable
         ``P(*p) -> StateSpace`` (the caller's, or the interpolated table).
     nmeas, ncon : int
+    shape : tuple of int
+        ``(states, inputs, outputs)`` of the plant.
+    grid : dict
+        The design grid ``{name: values}`` (the default table of :meth:`to_dict`).
+    rate : tuple of float
+        ``ν_k``, the bound on ``|dp_k/dt|`` the design holds for (0: frozen).
+    rate_form : {"X", "Y"}
+        With some ``ν_k > 0``: which Lyapunov matrix depends on ``p`` (and carries the
+        rate terms); the other one is constant, held as a 1-tuple.
+    frame : numpy.ndarray
+        With a rate bound: the state coordinates, fixed over the range, in which the
+        controller is formed (a frame that moved with ``p`` would put its derivative in
+        the controller).
     """
 
     names: tuple
@@ -328,6 +424,14 @@ class ScheduledController:
     ncon: int
     shape: tuple = field(repr=False, default=None)
     grid: dict = field(repr=False, default=None)
+    rate: tuple = None
+    frame: np.ndarray = field(repr=False, default=None)
+    rate_form: str = None
+
+    @property
+    def rate_bounded(self) -> bool:
+        """Designed for parameters that vary at bounded rates (some ν_k > 0)."""
+        return self.rate is not None and any(nu > 0 for nu in self.rate)
 
     def values(self, *args, **named) -> tuple:
         """The parameter values as a tuple in the order of ``names`` (checked)."""
@@ -351,9 +455,89 @@ class ScheduledController:
     def lyapunov(self, *args, **named) -> tuple[np.ndarray, np.ndarray]:
         """``(X(p), Y(p))`` of the scaled plant."""
         p = self.values(*args, **named)
-        f = _basis_values(self.basis, p, len(self.X))
-        return (sum(fi * Xi for fi, Xi in zip(f, self.X)),
-                sum(fi * Yi for fi, Yi in zip(f, self.Y)))
+        rated = self.rate_bounded
+        nb = len(self.Y) if rated and self.rate_form == "Y" else len(self.X)
+        f = _basis_values(self.basis, p, nb)
+        # with a rate bound one of them is constant (a 1-tuple, whatever the basis)
+        X = self.X[0] if rated and self.rate_form == "Y" else sum(
+            fi * Xi for fi, Xi in zip(f, self.X))
+        Y = self.Y[0] if rated and self.rate_form == "X" else sum(
+            fi * Yi for fi, Yi in zip(f, self.Y))
+        return X, Y
+
+    def lyapunov_rate(self, *args, **named) -> list[np.ndarray]:
+        """``Σ_k ṗ_k ∂V/∂p_k`` of the parameter-dependent one ``V`` of ``X``, ``Y``
+        (``rate_form``) at each vertex of the rate box (scaled plant); ``[0]`` for a
+        frozen-parameter design."""
+        p = self.values(*args, **named)
+        if not self.rate_bounded:
+            return [np.zeros_like(self.X[0])]
+        Vs = self.X if self.rate_form == "X" else self.Y
+        J = _basis_jacobian(self.basis, p, len(Vs))
+        dX = [sum(J[i, k] * Vi for i, Vi in enumerate(Vs)) for k in range(len(p))]
+        return [sum((v[k] * dX[k] for k in range(len(p)) if v[k]), np.zeros_like(self.X[0]))
+                for v in _vertices(self.rate)]
+
+    def inequalities(self, *args, level: float, **named) -> float:
+        """The largest eigenvalue, relative to the level, of the projected inequalities
+        and the coupling re-evaluated at ``p`` with ``X(p)``, ``Y(p)`` (and ``-Ẋ`` at
+        every vertex of the rate box) as the controller at ``level`` (plant units) is
+        formed from them: negative where they hold (certificate 4(b) of issue 61)."""
+        p = self.values(*args, **named)
+        X, Y = self.lyapunov(*p)
+        g = float(level) * self.scaling.gamma_factor
+        G = _plant_at(self.plant, p, self.nmeas, self.ncon, self.shape)
+        Ps = _apply_scaling(_without_d22(G), self.scaling)
+        return self._top(_lmi._projections(Ps, Ps, sparse=False), X, Y,
+                         self.lyapunov_rate(*p), g)
+
+    def _top(self, projections, X, Y, rates, g: float) -> float:
+        """:meth:`inequalities` at the scaled level ``g`` for given matrices."""
+        c = float(np.sqrt(g / self.gamma_lmi_scaled))
+        worst = []
+        # the X inequality carries -Ẋ, the Y one +Ẏ (one of them constant)
+        zero = [np.zeros_like(Y)]
+        x_rates = [-D for D in rates] if self.rate_form == "X" else zero
+        y_rates = rates if self.rate_form == "Y" else zero
+        for proj, V, dVs in zip(projections, (c * X, c * Y), (x_rates, y_rates)):
+            if proj is None:
+                continue
+            E = proj.F @ V @ proj.Nx
+            for dV in dVs:
+                top = E + E.T - g * proj.Q + c * (proj.Nx.T @ dV @ proj.Nx)
+                L = np.block([[top, proj.H], [proj.H.T, -g * np.eye(proj.H.shape[1])]])
+                worst.append(float(np.linalg.eigvalsh(_lmi._sym(L))[-1]))
+        n = X.shape[0]
+        cpl = np.block([[c * X, np.eye(n)], [np.eye(n), c * Y]])
+        worst.append(-float(np.linalg.eigvalsh(_lmi._sym(cpl))[0]))
+        return max(worst) / g
+
+    def closed_loop_lyapunov(self, *args, level: float, **named) -> np.ndarray:
+        """The closed loop's Lyapunov matrix ``P(p)`` that the controller formed at
+        ``level`` (plant units) is built on, in the coordinates ``[x_s; x_K]`` of the
+        scaled plant (``x = diag(scaling.T) x_s``) and the controller's states, for the
+        bounded-real inequality of the scaled loop at ``level * scaling.gamma_factor``
+        in the form ``[[AᵀP + PA + Ṗ, PB, Cᵀ], [BᵀP, -γI, Dᵀ], [C, D, -γI]] < 0``:
+        ``P Π₁ = Π₂`` with ``Π₁ = [[Y, I], [Mᵀ, 0]]``, ``Π₂ = [[I, X], [0, Nᵀ]]`` in the
+        frame the controller was formed in (Scherer, Gahinet & Chilali 1997; here ``Y``
+        is :meth:`lyapunov`'s ``X`` and vice versa).  For an independent check of the
+        controller; the test suite differentiates it in ``p``."""
+        p = self.values(*args, **named)
+        R, S = self.lyapunov(*p)
+        c = float(np.sqrt(float(level) * self.scaling.gamma_factor / self.gamma_lmi_scaled))
+        R, S = c * R, c * S
+        T = self.frame if self.rate_bounded else _lmi.balancing_transform(R, S)[0]
+        Ti = np.linalg.inv(T)
+        Yb, Xb = Ti @ R @ Ti.T, T.T @ S @ T
+        n = R.shape[0]
+        I, Z = np.eye(n), np.zeros((n, n))
+        IXY = I - Xb @ Yb
+        N, MT = (IXY, I) if self.rate_bounded and self.rate_form == "Y" else (I, IXY)
+        Pi1 = np.block([[Yb, I], [MT, Z]])
+        Pi2 = np.block([[I, Xb], [Z, N.T]])
+        Pb = np.linalg.solve(Pi1.T, Pi2.T).T
+        J = np.block([[Ti, Z], [Z, I]])
+        return _lmi._sym(J.T @ Pb @ J)
 
     def build(self, *args, **named) -> tuple[control.StateSpace, float, float]:
         """``(K, level, cond_xy)``: the controller at ``p``, the level (plant units) it was
@@ -361,7 +545,9 @@ class ScheduledController:
 
         The level is ``(1 + backoff) γ_lmi`` wherever the projected inequalities hold
         there (on the grid, by construction); between grid points, where they fail, the
-        next of ``_ESCALATION`` times it (said by the returned level)."""
+        first of ``_ESCALATION`` times it where they hold (:meth:`inequalities`; said
+        by the returned level).  The explicit formulas alone do not detect a failed
+        ``S`` inequality (the elimination checks one of its two projections)."""
         p = self.values(*args, **named)
         X, Y = self.lyapunov(*p)
         G = _plant_at(self.plant, p, self.nmeas, self.ncon, self.shape)
@@ -371,6 +557,8 @@ class ScheduledController:
         # iff it exceeds 1 (imposed on the grid only; between grid points of a rich
         # basis it fell to 0.985 on the mass-spring-damper of tests/test_lpv.py)
         # (with X(p) > 0; an indefinite X(p) fails at every level)
+        rates = self.lyapunov_rate(*p)
+        projections = _lmi._projections(Ps, Ps, sparse=False)
         definite = np.linalg.eigvalsh(_lmi._sym(X))[0] > 0.0
         lam = float(np.min(np.linalg.eigvals(X @ Y).real)) if definite else -np.inf
         last = None
@@ -384,8 +572,17 @@ class ScheduledController:
                 last = f"coupling: min eig(X(p) Y(p)) = {lam:.6g} against 1/{c2:.6g}"
                 continue
             c = float(np.sqrt(c2))
+            top = self._top(projections, X, Y, rates, level)
+            if not top < 0.0:
+                last = f"projected inequalities: largest eigenvalue {top:.3g} γ"
+                continue
             try:
-                Ks, cond_xy = _lmi.decoupled_controller(Ps, c * X, c * Y, level)
+                if self.rate_bounded:
+                    key = "dR" if self.rate_form == "X" else "dS"
+                    Ks, cond_xy = _lmi.decoupled_controller(
+                        Ps, c * X, c * Y, level, T=self.frame, **{key: [c * D for D in rates]})
+                else:
+                    Ks, cond_xy = _lmi.decoupled_controller(Ps, c * X, c * Y, level)
             except (SolverError, np.linalg.LinAlgError) as exc:
                 last = exc
                 continue
@@ -475,17 +672,23 @@ class ScheduledController:
                 if (G.nstates, G.ninputs, G.noutputs) != tuple(self.shape):
                     raise DimensionError(f"P{p} does not have the sizes {self.shape}")
                 blocks.append(np.block([[G.A, G.B], [G.C, G.D]]))
+        nb = max(len(self.X), len(self.Y))
         if isinstance(self.basis, _AffineBasis):
             basis = {"kind": "affine", "live": list(self.basis.live)}
         elif isinstance(self.basis, _TableBasis) and table is None:
             b_axes = self.basis.table.axes
+            b_nodes = list(itertools.product(*(a.tolist() for a in b_axes)))
             basis = {"kind": "table", "axes": [_floats(a) for a in b_axes],
-                     "values": [_floats(self.basis.table.nodes[p]) for p in
-                                itertools.product(*(a.tolist() for a in b_axes))]}
+                     "values": [_floats(self.basis.table.nodes[p]) for p in b_nodes]}
+            if self.basis.jac is not None:
+                basis["jacobian"] = [_floats(self.basis.jac.nodes[p]) for p in b_nodes]
         else:
             basis = {"kind": "table", "axes": [_floats(a) for a in axes],
-                     "values": [_floats(_basis_values(self.basis, p, len(self.X)))
-                                for p in nodes]}
+                     "values": [_floats(_basis_values(self.basis, p, nb)) for p in nodes]}
+            if self.rate_bounded:
+                # the rate terms of the controller need ∂f/∂p as well
+                basis["jacobian"] = [_floats(_basis_jacobian(self.basis, p, nb))
+                                     for p in nodes]
         sc = self.scaling
         return {
             "names": list(self.names),
@@ -503,6 +706,9 @@ class ScheduledController:
             "basis": basis,
             "exact_between_nodes": bool(plant_is_table and (
                 basis["kind"] == "affine" or isinstance(self.basis, _TableBasis))),
+            "rate": None if self.rate is None else [float(v) for v in self.rate],
+            "rate_form": self.rate_form,
+            "frame": None if self.frame is None else _floats(self.frame),
         }
 
     @classmethod
@@ -526,7 +732,9 @@ class ScheduledController:
                 b_nodes = list(itertools.product(*(a.tolist() for a in b_axes)))
                 if len(b["values"]) != len(b_nodes):
                     raise DimensionError("the basis table does not match its axes")
-                basis = _TableBasis(_GridTable(b_axes, dict(zip(b_nodes, b["values"]))))
+                jac = None if b.get("jacobian") is None else \
+                    _GridTable(b_axes, dict(zip(b_nodes, b["jacobian"])))
+                basis = _TableBasis(_GridTable(b_axes, dict(zip(b_nodes, b["values"]))), jac)
             else:
                 raise InputError(f"unknown basis kind {b['kind']!r}")
             sc = data["scaling"]
@@ -538,9 +746,14 @@ class ScheduledController:
             Y = tuple(np.asarray(M, dtype=float) for M in data["Y"])
             grid = None if data.get("grid") is None else \
                 {n: np.asarray(data["grid"][n], dtype=float) for n in names}
+            rate = None if data.get("rate") is None else \
+                tuple(float(v) for v in data["rate"])
+            frame = None if data.get("frame") is None else \
+                np.asarray(data["frame"], dtype=float)
             return cls(names, tuple((float(lo), float(hi)) for lo, hi in data["bounds"]),
                        basis, X, Y, float(data["gamma_lmi_scaled"]), float(data["backoff"]),
-                       scaling, plant, int(data["nmeas"]), int(data["ncon"]), shape, grid)
+                       scaling, plant, int(data["nmeas"]), int(data["ncon"]), shape, grid,
+                       rate, frame, data.get("rate_form"))
         except KeyError as exc:
             raise InputError(f"scheduled controller description lacks key {exc}") from exc
         except (TypeError, ValueError) as exc:
@@ -587,6 +800,14 @@ class LpvsynResult:
         formed at a higher one (its norm certified all the same).
     seconds, seconds_lmi, seconds_check : float
         Wall time in all, in the γ minimisation and in the check.
+    status : str
+        Clarabel's status of the γ minimisation.
+    inequality_check : numpy.ndarray
+        Certificate (b): at each check point, the largest eigenvalue (relative to the
+        level) of the projected inequalities re-evaluated with the returned ``X(p)``,
+        ``Y(p)`` — with ``-Ẋ(p)`` at every vertex of the rate box for ν > 0 — and of the
+        coupling, as the controller there was formed (:meth:`ScheduledController.inequalities`);
+        negative where they hold, a warning otherwise.
     """
 
     K: ScheduledController
@@ -602,6 +823,7 @@ class LpvsynResult:
     seconds_lmi: float
     seconds_check: float
     status: str = ""
+    inequality_check: np.ndarray = None
 
     def gamma_frozen(self, *args, **named) -> float:
         """``hinfnorm(lft(P(p), K(p)))`` at one parameter value (``inf`` if unstable)."""
@@ -611,19 +833,43 @@ class LpvsynResult:
 
 
 # --------------------------------------------------------------------------- synthesis
-def _gamma_lmi(plants, F, opts: HinfsynOptions, warnings: list):
-    """The γ minimisation over the grid (scaled plants, ``D22 = 0``)."""
+def _gamma_lmi(plants, F, opts: HinfsynOptions, warnings: list, J=None, nus=None,
+               form: str = "X"):
+    """The γ minimisation over the grid (scaled plants, ``D22 = 0``); with the basis
+    Jacobians ``J`` (one ``nb x k`` matrix per grid point) and rate bounds ``nus``, the
+    ``X`` inequality carries ``-Ẋ`` at every vertex of the rate box and ``Y`` is one
+    constant matrix (``form="X"``), or the ``Y`` inequality ``+Ẏ`` and ``X`` is
+    constant (``form="Y"``)."""
     n, nb = plants[0].nstates, F.shape[1]
-    Xs = [cp.Variable((n, n), symmetric=True) for _ in range(nb)]
-    Ys = [cp.Variable((n, n), symmetric=True) for _ in range(nb)]
+    rated = nus is not None and any(nu > 0 for nu in nus)
+    Xs = [cp.Variable((n, n), symmetric=True)
+          for _ in range(1 if rated and form == "Y" else nb)]
+    Ys = [cp.Variable((n, n), symmetric=True)
+          for _ in range(1 if rated and form == "X" else nb)]
     g = cp.Variable(nonneg=True)
     eye = np.eye(n)
     cons = []
-    for Pk, f in zip(plants, F):
-        X = sum(float(fi) * Xi for fi, Xi in zip(f, Xs))
-        Y = sum(float(fi) * Yi for fi, Yi in zip(f, Ys))
+    corners = _vertices(nus) if rated else []
+    for idx, (Pk, f) in enumerate(zip(plants, F)):
+        X = Xs[0] if rated and form == "Y" else sum(float(fi) * Xi for fi, Xi in zip(f, Xs))
+        Y = Ys[0] if rated and form == "X" else sum(float(fi) * Yi for fi, Yi in zip(f, Ys))
         pr, ps = _lmi._projections(Pk, Pk, sparse=False)
-        cons += [p.lmi(V, g, opts.margin) for p, V in ((pr, X), (ps, Y)) if p is not None]
+        for proj, V, Vs, sign, dependent in ((pr, X, Xs, -1.0, form == "X"),
+                                             (ps, Y, Ys, 1.0, form == "Y")):
+            if proj is None:
+                continue
+            if not (rated and dependent):
+                cons.append(proj.lmi(V, g, opts.margin))
+                continue
+            pad = np.zeros((proj.Nx.shape[1], proj.H.shape[1]))
+            for v in corners:
+                w = J[idx] @ v                                  # ∂f/∂p · ṗ
+                terms = [float(wi) * Vi for wi, Vi in zip(w, Vs) if wi]
+                L = proj.matrix(V, g)
+                if terms:
+                    L = L + sign * cp.bmat([[proj.Nx.T @ sum(terms) @ proj.Nx, pad],
+                                            [pad.T, np.zeros((pad.shape[1],) * 2)]])
+                cons.append(_lmi._sym(L) << -opts.margin * np.eye(L.shape[0]))
         cons += [_lmi._sym(cp.bmat([[X, eye], [eye, Y]])) >> 0,
                  cp.trace(X) + cp.trace(Y) <= opts.xy_bound * n]
     prob = cp.Problem(cp.Minimize(g), cons)
@@ -648,10 +894,11 @@ def _check_axes(axes, density: int):
 
 
 def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
-           rate: dict | None = None, backoff: float = BACKOFF, check_density: int = 4,
+           rate: dict | None = None, rate_form: str = "auto", backoff: float = BACKOFF,
+           check_density: int = 4,
            options: HinfsynOptions | None = None) -> LpvsynResult:
-    """Gain-scheduled H∞ output-feedback synthesis on a parameter grid, parameters frozen
-    during operation (rate bound ν = 0).
+    """Gain-scheduled H∞ output-feedback synthesis on a parameter grid, for parameters
+    frozen during operation (ν = 0) or varying at bounded rates ``|ṗ_k| <= ν_k``.
 
     Parameters
     ----------
@@ -669,7 +916,11 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
         ``f(*p) -> sequence`` of the basis functions of ``X(p)`` and ``Y(p)``; the
         default is ``[1]`` and each parameter with more than one grid value.
     rate : dict, optional
-        ``{name: ν}``, the bound on ``|dp/dt|``; only 0 (the default) is built.
+        ``{name: ν}``, the bound on ``|dp/dt|`` (per second; absent names: 0, frozen).
+    rate_form : {"auto", "X", "Y"}
+        With a rate bound: which Lyapunov matrix depends on ``p`` (the other one is
+        constant, so that the controller does not need ``ṗ``); ``"auto"`` solves both
+        LMIs and keeps the lower γ (twice the time).
     backoff : float
         The controller is formed at ``(1 + backoff) γ_lmi`` (see ``BACKOFF``).
     check_density : int
@@ -684,22 +935,23 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
 
     Raises
     ------
-    RateBoundNotBuiltError
-        A nonzero rate bound (ν > 0 is not built yet).
     NonFiniteError, DimensionError, DiscreteTimeError, ParameterError, InputError
-        Bad grid, plant or basis: NaN, an empty grid, discrete-time plants, sizes that
-        change across the grid, a basis of the wrong length, non-finite, or linearly
-        dependent on the grid.
+        Bad grid, plant, basis or rate: NaN, an empty grid, discrete-time plants, sizes
+        that change across the grid, a basis of the wrong length, non-finite, or
+        linearly dependent on the grid, a rate bound on a parameter with one grid
+        value, a negative or non-finite rate.
     InfeasibleError, SolverError
         No scheduled controller exists for this basis, or Clarabel failed.
 
     Notes
     -----
-    The controller is guaranteed for frozen parameters only: for each constant ``p``
-    the loop ``F_l(P(p), K(p))`` is stable with its norm below the level, certified on
-    the check grid; a parameter that varies during operation, however slowly, is not
-    covered (that needs the ``∂X/∂p`` terms of a rate bound ν > 0).  Between check
-    points nothing is certified.
+    With ν = 0 the controller is guaranteed for frozen parameters only: for each
+    constant ``p`` the loop ``F_l(P(p), K(p))`` is stable with its norm below the level,
+    certified on the check grid; a parameter that varies during operation, however
+    slowly, is not covered.  With ν > 0 the parameter-dependent inequalities (with the
+    ``∂X/∂p`` terms at every vertex of the rate box) are re-evaluated on the check grid
+    (``inequality_check``), which bounds the induced L2 gain for varying parameters
+    where they hold.  Between check points nothing is certified.
 
     Examples
     --------
@@ -739,14 +991,20 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
     rate = {} if rate is None else rate
     if not isinstance(rate, dict) or set(rate) - set(names):
         raise ParameterError(f"rate must be a dict over the parameters {names}, got {rate!r}")
-    for name, nu in rate.items():
-        nu = finite_scalar(nu, f"rate[{name!r}]")
+    nus = []
+    for name, a in zip(names, axes):
+        nu = finite_scalar(rate.get(name, 0.0), f"rate[{name!r}]")
         if nu < 0:
             raise ParameterError(f"rate[{name!r}] must be >= 0, got {nu}")
-        if nu > 0:
-            raise RateBoundNotBuiltError(
-                f"rate[{name!r}] = {nu:g}: rate-bounded (ν > 0) LPV synthesis is not built "
-                "yet; only frozen parameters (ν = 0) are")
+        if nu > 0 and a.size < 2:
+            raise ParameterError(f"rate[{name!r}] = {nu:g} but the grid gives {name!r} one "
+                                 "value: a parameter that varies needs a range (at least "
+                                 "two grid values)")
+        nus.append(nu)
+    nus = tuple(nus)
+    rated = any(nu > 0 for nu in nus)
+    if rate_form not in ("auto", "X", "Y"):
+        raise ParameterError(f"rate_form must be 'auto', 'X' or 'Y', got {rate_form!r}")
     basis = _default_basis(axes) if basis is None else basis
     if not callable(basis):
         raise InputError("basis must be a callable f(*p) -> sequence of float")
@@ -758,6 +1016,7 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
                              f"(rank {np.linalg.matrix_rank(F)} over {len(points)} points): "
                              "X(p), Y(p) would not be unique; drop a function or refine "
                              "the grid")
+    J = [_basis_jacobian(basis, p, nb) for p in points] if rated else None
     first = _plant_at(plant, points[0], nmeas, ncon)
     shape = (first.nstates, first.sys.ninputs, first.sys.noutputs)
     if not first.nstates:
@@ -773,16 +1032,45 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
     plants = [_apply_scaling(_without_d22(G), sc) for G in Gs]
     warnings: list[str] = []
     t1 = time.perf_counter()
-    g_s, Xi, Yi, status = _gamma_lmi(plants, F, opts, warnings)
+    notes = []
+    if not rated:
+        g_s, Xi, Yi, status = _gamma_lmi(plants, F, opts, warnings, J, nus)
+        form = None
+    else:
+        forms = ("X", "Y") if rate_form == "auto" else (rate_form,)
+        tried = {}
+        for fm in forms:
+            try:
+                tried[fm] = _gamma_lmi(plants, F, opts, warnings, J, nus, fm)
+            except InfeasibleError:
+                if len(forms) == 1:
+                    raise
+        if not tried:
+            raise InfeasibleError("the rate-bounded LMIs are infeasible with X(p) and with "
+                                  "Y(p) parameter dependent")
+        form = min(tried, key=lambda fm: tried[fm][0])
+        g_s, Xi, Yi, status = tried[form]
+        if len(tried) > 1:
+            notes.append("rate bound: γ_lmi with X(p) (Y constant) "
+                         f"{tried['X'][0] / sc.gamma_factor:.6g}, with Y(p) (X constant) "
+                         f"{tried['Y'][0] / sc.gamma_factor:.6g}; kept {form}(p)")
     t_lmi = time.perf_counter() - t1
+    frame = None
+    if rated:
+        # one frame for the whole range (a frame moving with p would put its derivative
+        # in the controller): the balancing of the middle grid point's pair
+        f_mid = F[len(points) // 2]
+        Xm = Xi[0] if form == "Y" else sum(fi * X for fi, X in zip(f_mid, Xi))
+        Ym = Yi[0] if form == "X" else sum(fi * Y for fi, Y in zip(f_mid, Yi))
+        frame = _lmi.balancing_transform(Xm, Ym)[0]
     K = ScheduledController(tuple(names), tuple((float(a[0]), float(a[-1])) for a in axes),
                             basis, Xi, Yi, g_s, backoff, sc, plant, int(nmeas), int(ncon),
-                            shape, dict(zip(names, axes)))
+                            shape, dict(zip(names, axes)), nus, frame, form)
     gamma_lmi = g_s / sc.gamma_factor
     t2 = time.perf_counter()
     check = _check_axes(axes, int(check_density))
     level0 = gamma_lmi * (1.0 + backoff)
-    norms, levels, escalated = [], [], []
+    norms, levels, escalated, ineq = [], [], [], []
     for p in itertools.product(*(a.tolist() for a in check)):
         where = ", ".join(f"{n}={v:.6g}" for n, v in zip(names, p))
         try:
@@ -791,7 +1079,12 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
             warnings.append(f"at {where}: {exc}")
             norms.append(np.inf)
             levels.append(np.inf)
+            ineq.append(np.inf)
             continue
+        ineq.append(K.inequalities(*p, level=level))
+        if ineq[-1] >= 0.0:
+            warnings.append(f"at {where}: the parameter-dependent inequalities fail with "
+                            f"the returned X(p), Y(p) (largest eigenvalue {ineq[-1]:.3g} γ)")
         if level > level0 * (1.0 + 1e-12):
             escalated.append(where)
         G = _plant_at(plant, p, nmeas, ncon, shape)
@@ -804,7 +1097,6 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
             warnings.append(f"at {where}: certified {gam:.6g} exceeds the LMI's level "
                             f"(1 + backoff) γ_lmi = {level0:.6g} by "
                             f"{100 * (gam / level0 - 1):.3g} %")
-    notes = []
     if escalated:
         notes.append(f"at {len(escalated)} of {len(norms)} check points ({escalated[0]}, "
                         f"...) the grid's LMIs do not hold at the level {level0:.6g}; the "
@@ -815,5 +1107,6 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
     return LpvsynResult(K=K, gamma=float(np.max(norms)), gamma_lmi=float(gamma_lmi),
                         grid=dict(zip(names, axes)), check_grid=dict(zip(names, check)),
                         gamma_check=norms, levels=np.asarray(levels),
+                        inequality_check=np.asarray(ineq),
                         warnings=tuple(warnings), notes=tuple(notes), seconds=t3 - t0,
                         seconds_lmi=t_lmi, seconds_check=t3 - t2, status=status)
