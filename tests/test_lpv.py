@@ -457,3 +457,101 @@ def test_rate_bounded_round_trip_with_a_callable_basis(tmp_path):
     # a basis that refuses complex numbers falls back to central differences
     J = _basis_jacobian(lambda m: [1.0, 1.0 / float(m)], (2.5,), 2)
     assert J[1, 0] == pytest.approx(-1.0 / 2.5**2, rel=1e-8)
+
+
+# ------------------------------------------------------------------- (g) three plants
+class _Repeated:
+    """``diag(K, ..., K)`` with the parameters of ``K`` shared: one LTI controller tuned
+    by ``hinfstruct`` on the stacked plants ``diag(P(p_1), ..., P(p_k))``, whose H∞ norm
+    is the largest of the loops' (a multi-model design: the robust controller)."""
+
+    def __init__(self, block, copies):
+        self.b, self.k = block, copies
+        self.name, self.param_names = block.name, block.param_names
+        self.ninputs, self.noutputs = copies * block.ninputs, copies * block.noutputs
+        self.nstates = copies * block.nstates
+
+    n_params = property(lambda self: self.b.n_params)
+    start = property(lambda self: self.b.start)
+
+    def matrices(self, theta):
+        import scipy.linalg
+
+        return tuple(scipy.linalg.block_diag(*([M] * self.k)) for M in self.b.matrices(theta))
+
+    def jacobian(self, theta):
+        Jb = np.asarray(self.b.jacobian(theta))
+        no, ni, n = self.b.noutputs, self.b.ninputs, self.b.nstates
+        J = np.zeros((self.n_params, self.noutputs + self.nstates, self.ninputs + self.nstates))
+        for c in range(self.k):
+            rows = np.r_[c * no:(c + 1) * no, self.noutputs + c * n:self.noutputs + (c + 1) * n]
+            cols = np.r_[c * ni:(c + 1) * ni, self.ninputs + c * n:self.ninputs + (c + 1) * n]
+            J[:, rows[:, None], cols[None, :]] = Jb
+        return J
+
+    def ss(self, theta):
+        return control.ss(*self.matrices(theta))
+
+    def values(self, theta):
+        return self.b.values(theta)
+
+    def freqresp_derivative(self, theta, s):
+        from lmi_suspension.tune.blocks import _freqresp_derivative
+
+        return _freqresp_derivative(self, np.asarray(theta, dtype=float), s)
+
+
+def _stacked(plants):
+    """``diag(P_1, ..., P_k)`` with w, u, z, y regrouped (one measurement, one control)."""
+    import scipy.linalg
+
+    from lmi_suspension.lti import GeneralizedPlant
+
+    bs = [GeneralizedPlant.from_statespace(P, 1, 1).blocks() for P in plants]
+    return GeneralizedPlant.from_matrices(
+        *(scipy.linalg.block_diag(*[b[k] for b in bs])
+          for k in ("A", "B1", "B2", "C1", "C2", "D11", "D12", "D21", "D22"))).sys
+
+
+def _gain_plant(b):
+    """The mass-spring-damper at m = 1 with the control force scaled by b."""
+    P = msd(1.0)
+    return control.ss(P.A, np.c_[P.B[:, :2], b * P.B[:, 2:]], P.C, P.D)
+
+
+THREE = {
+    "mass": (msd, np.linspace(1.0, 4.0, 9), lambda m: [1.0, m, 1.0 / m]),
+    "stiffness": (lambda k: msd(1.0, k=k), np.linspace(0.5, 4.0, 9), None),
+    "gain": (_gain_plant, np.linspace(0.5, 2.0, 9), lambda b: [1.0, b, 1.0 / b]),
+}
+
+
+@pytest.mark.slow  # 32 s on Zen 1 (2026-12-02): the second tier
+@pytest.mark.parametrize("name", list(THREE))
+def test_scheduled_between_frozen_optimum_and_robust_controller(name):
+    """Issue 61 acceptance: the certified scheduled γ lies between the worst frozen-point
+    optimum (hinfsyn's LMI lower bound at each design point: no scheduled controller can
+    beat it there) and the γ of one LTI controller over the range (a full-order block
+    tuned by hinfstruct on the plants at both ends and the middle, certified by hinfnorm
+    on the 33-point dense grid).  Measured 2026-12-02 (lower, scheduled, robust):
+    mass 0.240246, 0.246567, 0.283978; stiffness 0.24314, 0.24597, 0.248061; gain
+    0.33649, 0.340308, 0.368504."""
+    from lmi_suspension.lti import hinfnorm
+    from lmi_suspension.tune import hinfstruct, tunable_ss
+
+    P, grid, basis = THREE[name]
+    lower = max(hinfsyn(P(v), 1, 1).gamma_lower for v in grid)
+    res = lpvsyn(P, {"p": grid}, 1, 1, basis=basis)
+    assert res.warnings == ()
+    ends = grid[[0, grid.size // 2, -1]]
+    block = _Repeated(tunable_ss("K", 2, 1, 1), ends.size)
+    tuned = hinfstruct(_stacked([P(v) for v in ends]), block, ends.size, ends.size,
+                       starts=3, rng=np.random.default_rng(0))
+    K = block.b.ss(tuned.theta)
+    robust = max(float(hinfnorm(lft(P(v), K))[0]) for v in res.check_grid["p"])
+    assert lower <= res.gamma * (1.0 + 1e-6)               # a theorem (up to 1e-6)
+    # not a theorem (the scheduled γ carries the 2 % back-off and the tuning is local):
+    # measured margins 15 %, 0.85 %, 8.3 % (see above); the damping of the same
+    # plant, c in [0.05, 1], is a counter-example: there one LTI controller reaches the
+    # worst frozen optimum 0.242727 and the scheduled γ is 0.245556 (docs/guide/lpv.md)
+    assert res.gamma < robust
