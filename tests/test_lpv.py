@@ -196,9 +196,9 @@ def _discrete(m):
 
 
 @pytest.mark.parametrize("kwargs, err", [
-    (dict(grid={"m": [2.0]}, rate={"m": 0.1}), ParameterError),   # rate on one value
-    (dict(rate={"m": np.inf}), NonFiniteError),
-    (dict(rate={"m": -0.1}), ParameterError),
+    ({"grid": {"m": [2.0]}, "rate": {"m": 0.1}}, ParameterError),   # rate on one value
+    ({"rate": {"m": np.inf}}, NonFiniteError),
+    ({"rate": {"m": -0.1}}, ParameterError),
     (dict(grid={"m": [1.0, np.nan, 4.0]}), NonFiniteError),
     (dict(grid={"m": []}), ParameterError),
     (dict(grid={}), ParameterError),
@@ -243,11 +243,10 @@ def _same_ss(K1, K2):
 def test_json_round_trip_is_exact(linear, tmp_path):
     """Issue 61 item 3: the saved schedule loads back bit for bit (json writes each
     float's shortest round-tripping repr), and so does every frozen controller."""
-    from lmi_suspension.io import (controller_from_dict, load_scheduled_controller,
-                                   save_scheduled_controller)
+    from lmi_suspension import io
 
-    path = save_scheduled_controller(tmp_path / "K.json", linear, metadata={"note": "msd"})
-    K2, meta = load_scheduled_controller(path)
+    path = io.save_scheduled_controller(tmp_path / "K.json", linear, metadata={"note": "msd"})
+    K2, meta = io.load_scheduled_controller(path)
     K = linear.K
     assert meta == {"gamma": linear.gamma, "gamma_lmi": linear.gamma_lmi, "note": "msd"}
     assert K2.names == K.names and K2.bounds == K.bounds and K2.shape == K.shape
@@ -270,7 +269,7 @@ def test_json_round_trip_is_exact(linear, tmp_path):
     assert len(data["frozen"]) == GRID["m"].size
     for entry, m in zip(data["frozen"], GRID["m"]):
         assert entry["metadata"]["p"] == {"m": m}
-        assert _same_ss(controller_from_dict(entry), K.at(m=m))
+        assert _same_ss(io.controller_from_dict(entry), K.at(m=m))
 
 
 def test_json_round_trip_of_a_table_plant_is_exact_between_nodes(tmp_path):
@@ -286,20 +285,19 @@ def test_json_round_trip_of_a_table_plant_is_exact_between_nodes(tmp_path):
 
 def test_json_round_trip_of_a_callable_basis(tmp_path):
     """A caller's basis is tabulated: exact at the table's nodes (here a table given)."""
+    from lmi_suspension import io
     from lmi_suspension.errors import InputError
-    from lmi_suspension.io import (load_scheduled_controller, save_scheduled_controller,
-                                   scheduled_from_dict)
 
     res = lpvsyn(msd, {"m": [1.0, 2.5, 4.0]}, 1, 1, basis=lambda m: [1.0, m, 1.0 / m])
     table = {"m": [1.0, 1.5, 2.5, 3.1, 4.0]}
-    path = save_scheduled_controller(tmp_path / "K.json", res.K, table=table, frozen=False)
-    K2, _ = load_scheduled_controller(path)
+    path = io.save_scheduled_controller(tmp_path / "K.json", res.K, table=table, frozen=False)
+    K2, _ = io.load_scheduled_controller(path)
     for m in table["m"]:
         assert _same_ss(K2.at(m=m), res.K.at(m=m))
     with pytest.raises(ParameterError):                     # outside the design interval
-        save_scheduled_controller(tmp_path / "bad.json", res.K, table={"m": [0.5, 2.0]})
+        io.save_scheduled_controller(tmp_path / "bad.json", res.K, table={"m": [0.5, 2.0]})
     with pytest.raises(InputError):
-        scheduled_from_dict({"format": "lmi_suspension.controller/1"})
+        io.scheduled_from_dict({"format": "lmi_suspension.controller/1"})
 
 
 def test_mat_export_of_frozen_controllers(linear, tmp_path):
