@@ -553,3 +553,48 @@ def test_scheduled_between_frozen_optimum_and_robust_controller(name):
     # plant, c in [0.05, 1], is a counter-example: there one LTI controller reaches the
     # worst frozen optimum 0.242727 and the scheduled γ is 0.245556 (docs/guide/lpv.md)
     assert res.gamma < robust
+
+
+# ------------------------------------------------------------------- (h) polytopic hinfgs
+def _stiff(k):
+    return msd(1.0, k=k)
+
+
+def test_hinfgs_certified_for_any_rate_and_equal_to_the_gridded_lmi():
+    """Issue 61 item 2: the stiffness enters A only (affine, B2 constant).  The vertex
+    LMIs with one (R, S) are the gridded LMIs with basis [1] (the plant being affine, the
+    LMIs at the vertices hold on the whole box): two routes to one optimum, to Clarabel's
+    tolerance (measured 2026-12-02: 0.256240 both).  The closed loop's bounded-real
+    inequality with the one Lyapunov matrix holds at every check point: a bound for
+    parameters varying arbitrarily fast."""
+    from lmi_suspension.lpv import hinfgs
+
+    res = hinfgs(_stiff, {"k": (0.5, 4.0)}, 1, 1)
+    grid = lpvsyn(_stiff, {"k": np.linspace(0.5, 4.0, 5)}, 1, 1, basis=lambda k: [1.0])
+    assert res.gamma_lmi == pytest.approx(grid.gamma_lmi, rel=1e-4)
+    assert res.warnings == ()
+    assert res.check_grid["k"].size == 5 and np.all(res.lyapunov_check < 0.0)
+    assert res.gamma <= res.K.level * (1.0 + 1e-6)
+    # the schedule interpolates the vertex controllers: exact at the vertices
+    a = res.K.weights(k=1.2)
+    assert np.all(a >= 0.0) and a.sum() == pytest.approx(1.0, rel=1e-15)
+    assert _same_ss(res.K.at(k=4.0), res.K.controllers[1])
+    # and is a controller of the plant at any k: stable frozen loops
+    for k in (0.5, 1.7, 4.0):
+        assert np.max(np.linalg.eigvals(lft(_stiff(k), res.K.at(k=k)).A).real) < 0.0
+
+
+@pytest.mark.parametrize("P, bounds, err, text", [
+    (msd, {"m": (1.0, 4.0)}, "AssumptionError", "B2 depends"),       # u acts through 1/m
+    (lambda k: msd(1.0, k=k * k), {"k": (0.5, 2.0)}, "AssumptionError", "not affine"),
+    (_stiff, {"k": (1.0, 1.0)}, "ParameterError", "not an interval"),
+    (_stiff, {"k": (0.5, np.nan)}, "NonFiniteError", "finite"),
+])
+def test_hinfgs_typed_errors(P, bounds, err, text):
+    from lmi_suspension import errors
+    from lmi_suspension.lpv import hinfgs
+
+    t = time.perf_counter()
+    with pytest.raises(getattr(errors, err), match=text):
+        hinfgs(P, bounds, 1, 1)
+    assert time.perf_counter() - t < 1.0
