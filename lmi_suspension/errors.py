@@ -22,7 +22,7 @@ __all__ = [
     "SolverError",
     "IterationLimitError",
     "NotBuiltError",
-    "RateBoundNotBuiltError",
+    "NyquistError",
 ]
 
 
@@ -100,6 +100,6 @@ class NotBuiltError(LmiSuspensionError, NotImplementedError):
     works instead."""
 
 
-class RateBoundNotBuiltError(NotBuiltError):
-    """:func:`~lmi_suspension.lpv.lpvsyn` was asked for a nonzero rate bound ν: only
-    parameters frozen during operation (ν = 0) are built."""
+class NyquistError(ParameterError):
+    """A discrete realization was asked at a sample time whose Nyquist rate ``π/dt`` lies
+    below a pole of the controller: the sampled controller would not resolve it."""

@@ -10,6 +10,7 @@ IEEE-754 numbers bit for bit.
 
 from __future__ import annotations
 
+import itertools
 import json
 from pathlib import Path
 
@@ -21,7 +22,8 @@ from .lti.checks import as_finite_array, as_statespace
 
 __all__ = ["controller_to_dict", "controller_from_dict", "save_controller", "load_controller",
            "discrete_from_dict", "load_discrete_controller", "save_controller_mat",
-           "load_controller_mat"]
+           "load_controller_mat", "scheduled_to_dict", "scheduled_from_dict",
+           "save_scheduled_controller", "load_scheduled_controller", "save_scheduled_mat"]
 
 FORMAT = "lmi_suspension.controller/1"
 
@@ -273,3 +275,123 @@ def _json_default(obj):
     if isinstance(obj, np.ndarray):
         return obj.tolist()
     raise TypeError(f"cannot store {type(obj).__name__} in controller metadata")
+
+
+# ----------------------------------------------------------------- scheduled controllers
+SCHEDULED_FORMAT = "lmi_suspension.scheduled_controller/1"
+
+
+def scheduled_to_dict(K, *, table=None, frozen: bool = True, metadata=None) -> dict:
+    """Describe a :class:`~lmi_suspension.lpv.ScheduledController` (or the
+    :class:`~lmi_suspension.lpv.LpvsynResult` holding it: its ``gamma`` and
+    ``gamma_lmi`` then go into the metadata) as a JSON-ready dict.
+
+    The description holds everything :meth:`ScheduledController.at` needs (the
+    Lyapunov coefficients ``X_i``, ``Y_i``, the scalings, the plant and basis as tables:
+    see :meth:`~lmi_suspension.lpv.ScheduledController.to_dict`) and, with ``frozen``,
+    the frozen controller at every node of the design grid in this module's controller
+    format (``A``, ``B``, ``C``, ``D``, ``inputs``, ``outputs``, ``metadata`` with the
+    parameter values and the level), for a reader without this package.
+
+    Examples
+    --------
+    >>> import control, numpy as np
+    >>> from lmi_suspension.lpv import lpvsyn, ScheduledController
+    >>> def msd(m):
+    ...     return control.ss([[0, 1], [-1 / m, -0.2 / m]], [[0, 0, 0], [1 / m, 0, 1 / m]],
+    ...                       [[1, 0], [0, 0], [1, 0]], [[0, 0, 0], [0, 0, 0.1], [0, 0.1, 0]])
+    >>> K = lpvsyn(msd, {"m": [1.0, 2.0, 4.0]}, 1, 1).K
+    >>> K2 = scheduled_from_dict(scheduled_to_dict(K))
+    >>> bool(np.array_equal(K2.at(m=2.5).A, K.at(m=2.5).A))       # a table node
+    True
+    """
+    metadata = dict(metadata or {})
+    if hasattr(K, "K") and hasattr(K, "gamma_check"):        # an LpvsynResult
+        metadata = {"gamma": float(K.gamma), "gamma_lmi": float(K.gamma_lmi), **metadata}
+        K = K.K
+    data = {"format": SCHEDULED_FORMAT, **K.to_dict(table)}
+    if frozen:
+        entries = []
+        grid = K.grid if K.grid is not None else dict(zip(K.names, data["plant"]["axes"]))
+        for p in itertools.product(*(np.asarray(grid[n], dtype=float).tolist()
+                                     for n in K.names)):
+            Kp, level, _ = K.build(*p)
+            entries.append(controller_to_dict(
+                Kp, metadata={"p": dict(zip(K.names, p)), "level": float(level)}))
+        data["frozen"] = entries
+    data["metadata"] = metadata
+    return data
+
+
+def scheduled_from_dict(data: dict):
+    """The :class:`~lmi_suspension.lpv.ScheduledController` of
+    :func:`scheduled_to_dict` (exactly)."""
+    from .synthesis.lpv import ScheduledController
+
+    if not isinstance(data, dict) or data.get("format") != SCHEDULED_FORMAT:
+        raise InputError(f"not a scheduled controller description (format "
+                         f"{SCHEDULED_FORMAT!r})")
+    return ScheduledController.from_dict(data)
+
+
+def save_scheduled_controller(path, K, *, table=None, frozen: bool = True,
+                              metadata=None) -> Path:
+    """Write a scheduled controller to ``path`` as JSON (:func:`scheduled_to_dict`)."""
+    path = Path(path)
+    data = scheduled_to_dict(K, table=table, frozen=frozen, metadata=metadata)
+    path.write_text(json.dumps(data, indent=1, default=_json_default, allow_nan=False) + "\n")
+    return path
+
+
+def load_scheduled_controller(path):
+    """Read a file of :func:`save_scheduled_controller`: ``(K, metadata)``, ``K`` a
+    :class:`~lmi_suspension.lpv.ScheduledController` equal to the saved one (its
+    ``at`` bit for bit at every table node)."""
+    data = _read(path)
+    return scheduled_from_dict(data), dict(data.get("metadata", {}))
+
+
+def save_scheduled_mat(path, K, grid=None, *, dt: float | None = None) -> Path:
+    """Write the frozen controllers of a scheduled controller on a grid as a MATLAB
+    ``.mat`` file (``scipy.io.savemat``), MATLAB's layout of an array of models.
+
+    Variables: ``A`` (n x n x N), ``B`` (n x ny x N), ``C`` (nu x n x N), ``D``
+    (nu x ny x N) of the ``N`` grid points (doubles: the same IEEE-754 numbers as
+    ``K.at(p)``), ``P`` (N x k, the parameter values of each, in the order of
+    :func:`itertools.product`), ``ParameterName`` (cell array), one vector per
+    parameter with its grid values, ``Level`` (N, the level each controller was formed
+    at) and, with ``dt``, the Tustin realizations (:meth:`ScheduledController.at_discrete`)
+    instead, with ``Ts``.  In MATLAB: ``s = load(path); K = ss(s.A, s.B, s.C, s.D)``
+    is an ``N``-model array.
+
+    Parameters
+    ----------
+    grid : dict, optional
+        ``{name: values}``; default the design grid.
+    dt : float, optional
+        Sample time of discrete realizations (s).
+    """
+    import scipy.io
+
+    grid = K.grid if grid is None else grid
+    if not isinstance(grid, dict) or set(grid) != set(K.names):
+        raise InputError(f"grid must be a dict over the parameters {K.names}")
+    axes = [np.unique(as_finite_array(grid[n], f"grid[{n!r}]").ravel()) for n in K.names]
+    points = list(itertools.product(*(a.tolist() for a in axes)))
+    mats, levels = [], []
+    for p in points:
+        Kp, level, _ = K.build(*p)
+        if dt is not None:
+            Kp = K.at_discrete(*p, dt=dt)
+        mats.append(tuple(np.asarray(M, dtype=float) for M in (Kp.A, Kp.B, Kp.C, Kp.D)))
+        levels.append(level)
+    data = {k: np.stack([m[i] for m in mats], axis=-1) for i, k in enumerate("ABCD")}
+    data.update(P=np.asarray(points, dtype=float).reshape(len(points), len(K.names)),
+                ParameterName=np.array(list(K.names), dtype=object).reshape(-1, 1),
+                Level=np.asarray(levels, dtype=float))
+    data.update({n: a for n, a in zip(K.names, axes) if n not in data})
+    if dt is not None:
+        data["Ts"] = float(dt)
+    path = Path(path)
+    scipy.io.savemat(path, data, do_compression=False, oned_as="column")
+    return path

@@ -477,7 +477,37 @@ def _elimination_solution(Psi: np.ndarray, U: np.ndarray, V: np.ndarray,
     return -rho * U @ Phi @ V.T @ np.linalg.inv(_sym(V @ Phi @ V.T))
 
 
-def decoupled_controller(P: GeneralizedPlant, R: np.ndarray, S: np.ndarray, gamma: float):
+def _central_solution(Psi: np.ndarray, K: np.ndarray, Dt: np.ndarray, n: int, terms,
+                      what: str) -> np.ndarray:
+    """``Ω`` minimising, in the Loewner order, the Schur complement on the ``(w, z)``
+    block of ``Ψ`` with ``Ω Kᵀ + K Ωᵀ`` added to its state block and ``Ω Dt`` to its
+    ``(state, (w, z))`` block; then checked with each of ``terms`` added to the state
+    block (the ``∓`` derivative of the Lyapunov matrix at each vertex of a rate box).
+
+    With ``Ψ = [[P0, Q], [Qᵀ, E]]`` (``E < 0`` iff ``‖D11‖ < γ``) and ``Z = -E⁻¹`` the
+    complement is ``P0 + Ω Kᵀ + K Ωᵀ + (Q + Ω Dt) Z (Q + Ω Dt)ᵀ = (Ω - Ω*) W (Ω - Ω*)ᵀ +
+    const`` with ``W = Dt Z Dtᵀ`` (positive definite when ``D12`` has full column rank,
+    resp. ``D21`` full row rank) and ``Ω* = -(Q Z Dtᵀ + K) W⁻¹``: it satisfies every
+    vertex wherever any ``Ω`` satisfies each."""
+    P0, Q, E = Psi[:n, :n], Psi[:n, n:], Psi[n:, n:]
+    Zm = -np.linalg.inv(_sym(E))
+    W = _sym(Dt @ Zm @ Dt.T)
+    if W.size and np.linalg.eigvalsh(W)[0] <= 1e-12 * max(1.0, np.abs(W).max()):
+        raise SolverError(f"{what}: D12 (resp. D21) is not of full rank (a singular "
+                          "problem): no ṗ-independent central gain")
+    Om = -np.linalg.solve(W, (Q @ Zm @ Dt.T + K).T).T
+    Qc = Q + Om @ Dt
+    base = P0 + Om @ K.T + K @ Om.T + Qc @ Zm @ Qc.T
+    for D in terms:
+        top = float(np.linalg.eigvalsh(_sym(base + D))[-1])
+        if top >= 0.0:
+            raise SolverError(f"{what}: the inequality fails at a vertex of the rate box "
+                              f"(largest eigenvalue {top:.3g})")
+    return Om
+
+
+def decoupled_controller(P: GeneralizedPlant, R: np.ndarray, S: np.ndarray, gamma: float,
+                         *, dR=(), dS=(), T: np.ndarray | None = None):
     """Controller from ``(R, S)`` without an SDP: the explicit route of Gahinet (1996).
 
     With ``Y = R``, ``X = S`` fixed and ``D_K = 0``, the bounded-real inequality in the
@@ -496,14 +526,36 @@ def decoupled_controller(P: GeneralizedPlant, R: np.ndarray, S: np.ndarray, gamm
     one certified on all 18 (COMPleib and ``bench_hinfsyn.py`` plants, (R, S) of the
     γ-optimal solve scaled by ``sqrt(1 + r)``, ``r >= 5e-4``; measured 2026-11-27).
 
+    Rate-bounded gain scheduling (:func:`~lmi_suspension.lpv.lpvsyn` with ν > 0) passes
+    a frame ``T`` fixed over the parameter range and either ``dR``, the values of
+    ``Ṙ = Σ_k ṗ_k ∂R/∂p_k`` at the vertices of the rate box (``S`` constant), or ``dS``
+    (``R`` constant).  The ``R`` inequality then carries ``-Ṙ`` in its state block at
+    every vertex (resp. the ``S`` one ``+Ṡ``), and its gain ``Ĉ`` (resp. ``B̂``) must
+    not depend on ``ṗ``: it is the Loewner minimiser of the inequality's Schur
+    complement (:func:`_central_solution`), which satisfies every vertex wherever any
+    gain satisfies each (the ``ṗ`` terms sit in the state block); each vertex is
+    checked.  In the variables of Scherer, Gahinet & Chilali, the closed loop's
+    Lyapunov derivative adds ``-(X Ẏ + N Ṁᵀ)`` to the block of ``Â``: it vanishes when
+    ``S`` (here ``X``) and ``N`` are constant (``N = I`` in the frame, ``Mᵀ = I - XY``),
+    resp. when ``R`` and ``M`` are (``M = I``, ``N = I - XY``), so the controller
+    does not depend on ``ṗ`` (Apkarian & Adams 1998, §3).
+
     Returns ``(K, cond_xy)``; raises :class:`SolverError` where a projected inequality
     fails at ``gamma`` or ``‖D11‖ >= gamma``.
     """
     from ..lti.scaling import transform_states
 
-    frame = Frame.from_lyapunov(R, S)
-    Pb = transform_states(P, frame.T)
-    Y = X = np.diag(frame.sigma)
+    if T is None:
+        frame = Frame.from_lyapunov(R, S)
+        Pb = transform_states(P, frame.T)
+        Y = X = np.diag(frame.sigma)
+    else:
+        T = np.asarray(T, dtype=float)
+        Pb = transform_states(P, T)
+        Ti = np.linalg.inv(T)
+        Y, X = _sym(Ti @ R @ Ti.T), _sym(T.T @ S @ T)
+        dR = [_sym(Ti @ np.asarray(D, dtype=float) @ Ti.T) for D in dR]
+        dS = [_sym(T.T @ np.asarray(D, dtype=float) @ T) for D in dS]
     b = Pb.blocks()
     A, B1, B2, C1, C2 = b["A"], b["B1"], b["B2"], b["C1"], b["C2"]
     D11, D12, D21 = b["D11"], b["D12"], b["D21"]
@@ -514,20 +566,36 @@ def decoupled_controller(P: GeneralizedPlant, R: np.ndarray, S: np.ndarray, gamm
     I, Z = np.eye, np.zeros
     Psi_R = np.block([[A @ Y + Y @ A.T, B1, Y @ C1.T], [B1.T, -g * I(nw), D11.T],
                       [C1 @ Y, D11, -g * I(nz)]])
-    Ch = _elimination_solution(Psi_R, np.hstack([B2.T, Z((nu, nw)), D12.T]),
-                               np.hstack([I(n), Z((n, nw + nz))]), "explicit controller (R)")
+    if len(dR):
+        Ch = _central_solution(Psi_R, B2, np.hstack([Z((nu, nw)), D12.T]), n,
+                               [-D for D in dR], "rate-bounded controller (R)").T
+    else:
+        Ch = _elimination_solution(Psi_R, np.hstack([B2.T, Z((nu, nw)), D12.T]),
+                                   np.hstack([I(n), Z((n, nw + nz))]),
+                                   "explicit controller (R)")
     Psi_S = np.block([[X @ A + A.T @ X, X @ B1, C1.T], [B1.T @ X, -g * I(nw), D11.T],
                       [C1, D11, -g * I(nz)]])
-    Bh = _elimination_solution(Psi_S, np.hstack([I(n), Z((n, nw + nz))]),
-                               np.hstack([C2, D21, Z((ny, nz))]), "explicit controller (S)")
+    if len(dS):
+        Bh = _central_solution(Psi_S, C2.T, np.hstack([D21, Z((ny, nz))]), n, dS,
+                               "rate-bounded controller (S)")
+    else:
+        Bh = _elimination_solution(Psi_S, np.hstack([I(n), Z((n, nw + nz))]),
+                                   np.hstack([C2, D21, Z((ny, nz))]),
+                                   "explicit controller (S)")
     # Â: the block the elimination lemma removes, for D_K = 0
     E = np.block([[-g * I(nw), D11.T], [D11, -g * I(nz)]])
     left = np.vstack([(X @ B1 + Bh @ D21).T, C1])
     right = np.vstack([B1.T, C1 @ Y + D12 @ Ch])
     Ah = left.T @ np.linalg.solve(E, right) - A.T
-    MT = I(n) - X @ Y
-    sv = np.linalg.svd(MT, compute_uv=False)
+    IXY = I(n) - X @ Y
+    sv = np.linalg.svd(IXY, compute_uv=False)
     cond_xy = float(sv[0] / sv[-1]) if n and sv[-1] > 0 else float("inf")
+    if len(dS):
+        # N = I - XY, M = I: B_K = N⁻¹ B̂, C_K = Ĉ, A_K = N⁻¹ (Â - B̂ C2 Y - X B2 Ĉ - X A Y)
+        Bk = np.linalg.solve(IXY, Bh)
+        Ak = np.linalg.solve(IXY, Ah - Bh @ C2 @ Y - X @ B2 @ Ch - X @ A @ Y)
+        return control.ss(Ak, Bk, Ch, np.zeros((nu, ny))), cond_xy
+    MT = IXY
     Ck = np.linalg.solve(MT.T, Ch.T).T
     Ak = np.linalg.solve(MT.T, (Ah - X @ B2 @ Ck @ MT - Bh @ C2 @ Y - X @ A @ Y).T).T
     return control.ss(Ak, Bh, Ck, np.zeros((nu, ny))), cond_xy

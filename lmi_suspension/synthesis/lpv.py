@@ -1,5 +1,5 @@
-"""Gridded gain-scheduled H∞ output-feedback synthesis (:func:`lpvsyn`), parameters frozen
-during operation (rate bound ν = 0).
+"""Gridded gain-scheduled H∞ output-feedback synthesis (:func:`lpvsyn`), for parameters
+frozen during operation (rate bound ν = 0) or varying at bounded rates ``|ṗ_k| <= ν_k``.
 
 The plant ``P(p)`` is given on a grid of a measured parameter vector ``p`` (a callable
 ``p -> StateSpace``, or a list of ``(p, plant)`` pairs whose matrices are interpolated
@@ -19,8 +19,23 @@ settings of :mod:`.lmi`).  With ν = 0 the Lyapunov inequalities carry no ``∂X
 term (Wu et al. 1996, Apkarian & Adams 1998 with a zero rate bound): the controller is
 guaranteed **for frozen parameters** — for each constant ``p`` the loop is stable with
 ``‖F_l(P(p), K(p))‖∞`` below the level — and nothing is claimed for a ``p`` that moves
-during operation; slowly varying parameters need ν > 0, which is not built yet
-(:class:`RateBoundNotBuiltError`).
+during operation.
+
+With a rate bound ν > 0 (Wu et al. 1996; Apkarian & Adams 1998) the ``X`` inequality
+carries ``-Ẋ = -Σ_k ṗ_k ∂X/∂p_k`` (the ``Y`` one ``+Ẏ``) in its state block, imposed at
+every vertex ``ṗ_k = ±ν_k`` of the rate box at every grid point.  With both matrices
+parameter dependent the controller would need ``ṗ`` (LPVTools' ``lpvsyn`` returns such
+a controller); here one of them is constant (``rate_form``: ``"X"`` makes ``X(p)``
+dependent and ``Y`` constant, ``"Y"`` the converse, ``"auto"`` solves both and keeps
+the lower γ), so that with controller coordinates fixed over the range the derivative
+term in the controller's ``Â`` block vanishes and ``K(p)`` depends on ``p`` only
+(Apkarian & Adams 1998, §3).  The price is measured in ``tests/test_lpv.py``: on its
+mass-spring-damper the ``ṗ``-free forms reach γ_lmi 0.477, about what a constant pair
+reaches (0.4775), against 0.312 for frozen parameters with the same basis.  The
+closed loop then satisfies the bounded-real inequality with ``Ṗ`` at every vertex for
+the Lyapunov matrix :meth:`ScheduledController.closed_loop_lyapunov`: its induced
+L2 gain is below the level for every trajectory ``p(t)`` in the range with
+``|ṗ_k| <= ν_k`` — where the inequalities hold, which is checked on the dense grid.
 
 The scheduled controller is formed at any ``p`` (between grid points too) from
 ``X(p)``, ``Y(p)`` and ``P(p)`` by the project's explicit formulas
@@ -46,12 +61,14 @@ import time
 from dataclasses import dataclass, field
 from typing import Callable
 
+import logging
+
 import control
 import cvxpy as cp
 import numpy as np
 
 from ..errors import (DimensionError, InfeasibleError, InputError, NonFiniteError,
-                      ParameterError, RateBoundNotBuiltError, SolverError)
+                      NyquistError, ParameterError, SolverError)
 from ..lti.checks import as_statespace, finite_scalar
 from ..lti.norms import hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
@@ -60,7 +77,9 @@ from . import lmi as _lmi
 from .hinfsyn import _undo_loop_shift, _without_d22
 from .result import HinfsynOptions
 
-__all__ = ["lpvsyn", "LpvsynResult", "ScheduledController", "RateBoundNotBuiltError"]
+__all__ = ["lpvsyn", "LpvsynResult", "ScheduledController"]
+
+logger = logging.getLogger(__name__)
 
 #: default back-off of the reconstruction level above the LMI optimum (relative).  The
 #: explicit formulas at ``(1 + r) γ_lmi`` with ``(X, Y)`` scaled by ``sqrt(1 + r)`` have
@@ -113,33 +132,94 @@ def _axes(grid) -> tuple[tuple[str, ...], tuple[np.ndarray, ...]]:
     return tuple(names), tuple(axes)
 
 
+class _GridTable:
+    """An array-valued function known on a rectangular grid: the stored values exactly
+    at the nodes, their multilinear interpolation in between (axes with one value take
+    no part in it; scipy needs two)."""
+
+    def __init__(self, axes, nodes: dict):
+        import scipy.interpolate
+
+        self.axes = tuple(np.asarray(a, dtype=float) for a in axes)
+        self.nodes = {tuple(float(v) for v in k): np.asarray(m, dtype=float)
+                      for k, m in nodes.items()}
+        first = next(iter(self.nodes.values()))
+        self._live = [i for i, a in enumerate(self.axes) if a.size > 1]
+        data = np.empty(tuple(a.size for a in self.axes) + first.shape)
+        for idx in itertools.product(*(range(a.size) for a in self.axes)):
+            data[idx] = self.nodes[tuple(float(a[i]) for a, i in zip(self.axes, idx))]
+        data = data.reshape(tuple(self.axes[i].size for i in self._live) + first.shape)
+        self._data = data
+        self._interp = None if not self._live else scipy.interpolate.RegularGridInterpolator(
+            tuple(self.axes[i] for i in self._live), data, method="linear")
+
+    def __call__(self, p) -> np.ndarray:
+        # at a node the stored value itself, so a table of a function reproduces it
+        # there bit for bit (the interpolation's weights 1 and 0 need not)
+        hit = self.nodes.get(tuple(float(v) for v in p))
+        if hit is not None:
+            return hit.copy()
+        if self._interp is None:
+            return self._data.copy()
+        return self._interp(np.asarray([p[i] for i in self._live], dtype=float)[None, :])[0]
+
+
 class _TablePlant:
     """A plant known on a rectangular grid, its state-space matrices interpolated
     (multi)linearly in between (LPVTools' convention for gridded systems)."""
 
     def __init__(self, axes, table: dict, shape):
-        import scipy.interpolate
+        self.shape = tuple(shape)
+        self.table = _GridTable(axes, {p: np.block([[sys.A, sys.B], [sys.C, sys.D]])
+                                       for p, sys in table.items()})
 
-        self.shape = shape
-        # axes with one value take no part in the interpolation (scipy needs two)
-        self._live = [i for i, a in enumerate(axes) if a.size > 1]
-        n, m, q = shape
-        data = np.empty(tuple(a.size for a in axes) + (n + q, n + m))
-        for idx in itertools.product(*(range(a.size) for a in axes)):
-            sys = table[tuple(float(a[i]) for a, i in zip(axes, idx))]
-            data[idx] = np.block([[sys.A, sys.B], [sys.C, sys.D]])
-        data = data.reshape(tuple(axes[i].size for i in self._live) + data.shape[-2:])
-        self._interp = None if not self._live else scipy.interpolate.RegularGridInterpolator(
-            tuple(axes[i] for i in self._live), data, method="linear")
-        self._data = data
+    @classmethod
+    def from_blocks(cls, axes, blocks: dict, shape) -> _TablePlant:
+        """From ``{p: [[A, B], [C, D]]}`` (a saved table)."""
+        self = cls.__new__(cls)
+        self.shape = tuple(shape)
+        self.table = _GridTable(axes, blocks)
+        return self
 
     def __call__(self, *p):
         n = self.shape[0]
-        if self._interp is None:
-            M = self._data
-        else:
-            M = self._interp(np.asarray([p[i] for i in self._live], dtype=float)[None, :])[0]
+        M = self.table(p)
         return control.ss(M[:n, :n], M[:n, n:], M[n:, :n], M[n:, n:])
+
+
+class _AffineBasis:
+    """The default basis ``[1]`` and each parameter that takes more than one grid value
+    (a class, not a closure, so a saved controller can name it)."""
+
+    def __init__(self, live):
+        self.live = tuple(int(i) for i in live)
+
+    def __call__(self, *p):
+        return [1.0] + [p[i] for i in self.live]
+
+    def jacobian(self, *p) -> np.ndarray:
+        """``∂f_i/∂p_k`` (exact)."""
+        J = np.zeros((1 + len(self.live), len(p)))
+        for r, i in enumerate(self.live):
+            J[1 + r, i] = 1.0
+        return J
+
+
+class _TableBasis:
+    """A basis known on a grid (a loaded controller's), interpolated in between, with
+    its Jacobian where the saved controller is rate bounded."""
+
+    def __init__(self, table: _GridTable, jac: _GridTable | None = None):
+        self.table = table
+        self.jac = jac
+
+    def __call__(self, *p):
+        return self.table(p)
+
+    def jacobian(self, *p) -> np.ndarray:
+        if self.jac is None:
+            raise InputError("this saved basis has no Jacobian (saved without a rate bound)")
+        return self.jac(p)
 
 
 def _from_pairs(pairs, grid):
@@ -190,8 +270,7 @@ def _from_pairs(pairs, grid):
 
 def _default_basis(axes):
     """``[1]`` and each parameter that takes more than one value on the grid."""
-    live = [i for i, a in enumerate(axes) if a.size > 1]
-    return lambda *p: [1.0] + [p[i] for i in live]
+    return _AffineBasis(i for i, a in enumerate(axes) if a.size > 1)
 
 
 def _basis_values(basis, p, nb: int | None) -> np.ndarray:
@@ -207,6 +286,56 @@ def _basis_values(basis, p, nb: int | None) -> np.ndarray:
     if not np.all(np.isfinite(f)):
         raise NonFiniteError(f"the basis is not finite at p = {p}: {f}")
     return f
+
+
+#: complex step of the basis derivative (relative to max(1, |p_k|)): exact to roundoff
+#: for any basis written with arithmetic and numpy functions (Squire & Trapp 1998)
+_COMPLEX_STEP = 1e-30
+#: central-difference step (relative) where the basis does not take complex values, and
+#: the tolerance within which the complex step must agree with it
+_FD_STEP = 1e-6
+_FD_RTOL = 1e-5
+
+
+def _basis_jacobian(basis, p, nb: int) -> np.ndarray:
+    """``J[i, k] = ∂f_i/∂p_k`` at ``p``: the basis's own ``jacobian`` where it has one,
+    else by complex step, checked against central differences (used alone where the
+    callable refuses complex numbers)."""
+    if hasattr(basis, "jacobian"):
+        return np.asarray(basis.jacobian(*p), dtype=float).reshape(nb, len(p))
+    J = np.empty((nb, len(p)))
+    for k in range(len(p)):
+        h = _FD_STEP * max(1.0, abs(p[k]))
+        hi = tuple(v + (h if i == k else 0.0) for i, v in enumerate(p))
+        lo = tuple(v - (h if i == k else 0.0) for i, v in enumerate(p))
+        fd = (_basis_values(basis, hi, nb) - _basis_values(basis, lo, nb)) / (2 * h)
+        try:
+            hc = _COMPLEX_STEP * max(1.0, abs(p[k]))
+            pc = tuple(complex(v, hc if i == k else 0.0) for i, v in enumerate(p))
+            cs = np.asarray(basis(*pc), dtype=complex).ravel().imag / hc
+        except (TypeError, ValueError):
+            cs = None
+        if cs is not None and cs.size == nb and np.all(np.isfinite(cs)) and np.allclose(
+                cs, fd, rtol=_FD_RTOL, atol=_FD_RTOL * max(1.0, np.abs(fd).max())):
+            J[:, k] = cs
+        else:
+            logger.info("basis derivative by central differences at p = %s", p)
+            J[:, k] = fd
+    if not np.all(np.isfinite(J)):
+        raise NonFiniteError(f"the basis derivative is not finite at p = {p}")
+    return J
+
+
+def _vertices(nus) -> list[np.ndarray]:
+    """The corners of the rate box ``|ṗ_k| <= ν_k`` (parameters with ν_k = 0 fixed at 0)."""
+    live = [k for k, nu in enumerate(nus) if nu > 0]
+    out = []
+    for signs in itertools.product((-1.0, 1.0), repeat=len(live)):
+        v = np.zeros(len(nus))
+        for k, sg in zip(live, signs):
+            v[k] = sg * nus[k]
+        out.append(v)
+    return out
 
 
 def _plant_at(plant, p, nmeas, ncon, shape=None) -> GeneralizedPlant:
@@ -232,10 +361,15 @@ def _apply_scaling(G: GeneralizedPlant, sc: PlantScaling) -> GeneralizedPlant:
         Sy[:, None] * b["D21"] * cw, np.zeros_like(b["D22"]))
 
 
+def _floats(M):
+    """A numpy array as nested lists of Python floats (json writes them exactly)."""
+    return np.asarray(M, dtype=float).tolist()
+
+
 # --------------------------------------------------------------------------- controller
 @dataclass(frozen=True)
 class ScheduledController:
-    """A controller scheduled on a measured parameter, frozen-parameter (ν = 0) design.
+    """A controller scheduled on a measured parameter (frozen or rate-bounded design).
 
     ``K.at(m3=42.0)`` (or ``K.at(42.0)`` for one parameter) is the controller at that
     value: the explicit formulas of
@@ -262,6 +396,19 @@ class ScheduledController:
     plant : callable
         ``P(*p) -> StateSpace`` (the caller's, or the interpolated table).
     nmeas, ncon : int
+    shape : tuple of int
+        ``(states, inputs, outputs)`` of the plant.
+    grid : dict
+        The design grid ``{name: values}`` (the default table of :meth:`to_dict`).
+    rate : tuple of float
+        ``ν_k``, the bound on ``|dp_k/dt|`` the design holds for (0: frozen).
+    rate_form : {"X", "Y"}
+        With some ``ν_k > 0``: which Lyapunov matrix depends on ``p`` (and carries the
+        rate terms); the other one is constant, held as a 1-tuple.
+    frame : numpy.ndarray
+        With a rate bound: the state coordinates, fixed over the range, in which the
+        controller is formed (a frame that moved with ``p`` would put its derivative in
+        the controller).
     """
 
     names: tuple
@@ -276,6 +423,15 @@ class ScheduledController:
     nmeas: int
     ncon: int
     shape: tuple = field(repr=False, default=None)
+    grid: dict = field(repr=False, default=None)
+    rate: tuple = None
+    frame: np.ndarray = field(repr=False, default=None)
+    rate_form: str = None
+
+    @property
+    def rate_bounded(self) -> bool:
+        """Designed for parameters that vary at bounded rates (some ν_k > 0)."""
+        return self.rate is not None and any(nu > 0 for nu in self.rate)
 
     def values(self, *args, **named) -> tuple:
         """The parameter values as a tuple in the order of ``names`` (checked)."""
@@ -299,9 +455,89 @@ class ScheduledController:
     def lyapunov(self, *args, **named) -> tuple[np.ndarray, np.ndarray]:
         """``(X(p), Y(p))`` of the scaled plant."""
         p = self.values(*args, **named)
-        f = _basis_values(self.basis, p, len(self.X))
-        return (sum(fi * Xi for fi, Xi in zip(f, self.X)),
-                sum(fi * Yi for fi, Yi in zip(f, self.Y)))
+        rated = self.rate_bounded
+        nb = len(self.Y) if rated and self.rate_form == "Y" else len(self.X)
+        f = _basis_values(self.basis, p, nb)
+        # with a rate bound one of them is constant (a 1-tuple, whatever the basis)
+        X = self.X[0] if rated and self.rate_form == "Y" else sum(
+            fi * Xi for fi, Xi in zip(f, self.X))
+        Y = self.Y[0] if rated and self.rate_form == "X" else sum(
+            fi * Yi for fi, Yi in zip(f, self.Y))
+        return X, Y
+
+    def lyapunov_rate(self, *args, **named) -> list[np.ndarray]:
+        """``Σ_k ṗ_k ∂V/∂p_k`` of the parameter-dependent one ``V`` of ``X``, ``Y``
+        (``rate_form``) at each vertex of the rate box (scaled plant); ``[0]`` for a
+        frozen-parameter design."""
+        p = self.values(*args, **named)
+        if not self.rate_bounded:
+            return [np.zeros_like(self.X[0])]
+        Vs = self.X if self.rate_form == "X" else self.Y
+        J = _basis_jacobian(self.basis, p, len(Vs))
+        dX = [sum(J[i, k] * Vi for i, Vi in enumerate(Vs)) for k in range(len(p))]
+        return [sum((v[k] * dX[k] for k in range(len(p)) if v[k]), np.zeros_like(self.X[0]))
+                for v in _vertices(self.rate)]
+
+    def inequalities(self, *args, level: float, **named) -> float:
+        """The largest eigenvalue, relative to the level, of the projected inequalities
+        and the coupling re-evaluated at ``p`` with ``X(p)``, ``Y(p)`` (and ``-Ẋ`` at
+        every vertex of the rate box) as the controller at ``level`` (plant units) is
+        formed from them: negative where they hold (certificate 4(b) of issue 61)."""
+        p = self.values(*args, **named)
+        X, Y = self.lyapunov(*p)
+        g = float(level) * self.scaling.gamma_factor
+        G = _plant_at(self.plant, p, self.nmeas, self.ncon, self.shape)
+        Ps = _apply_scaling(_without_d22(G), self.scaling)
+        return self._top(_lmi._projections(Ps, Ps, sparse=False), X, Y,
+                         self.lyapunov_rate(*p), g)
+
+    def _top(self, projections, X, Y, rates, g: float) -> float:
+        """:meth:`inequalities` at the scaled level ``g`` for given matrices."""
+        c = float(np.sqrt(g / self.gamma_lmi_scaled))
+        worst = []
+        # the X inequality carries -Ẋ, the Y one +Ẏ (one of them constant)
+        zero = [np.zeros_like(Y)]
+        x_rates = [-D for D in rates] if self.rate_form == "X" else zero
+        y_rates = rates if self.rate_form == "Y" else zero
+        for proj, V, dVs in zip(projections, (c * X, c * Y), (x_rates, y_rates)):
+            if proj is None:
+                continue
+            E = proj.F @ V @ proj.Nx
+            for dV in dVs:
+                top = E + E.T - g * proj.Q + c * (proj.Nx.T @ dV @ proj.Nx)
+                L = np.block([[top, proj.H], [proj.H.T, -g * np.eye(proj.H.shape[1])]])
+                worst.append(float(np.linalg.eigvalsh(_lmi._sym(L))[-1]))
+        n = X.shape[0]
+        cpl = np.block([[c * X, np.eye(n)], [np.eye(n), c * Y]])
+        worst.append(-float(np.linalg.eigvalsh(_lmi._sym(cpl))[0]))
+        return max(worst) / g
+
+    def closed_loop_lyapunov(self, *args, level: float, **named) -> np.ndarray:
+        """The closed loop's Lyapunov matrix ``P(p)`` that the controller formed at
+        ``level`` (plant units) is built on, in the coordinates ``[x_s; x_K]`` of the
+        scaled plant (``x = diag(scaling.T) x_s``) and the controller's states, for the
+        bounded-real inequality of the scaled loop at ``level * scaling.gamma_factor``
+        in the form ``[[AᵀP + PA + Ṗ, PB, Cᵀ], [BᵀP, -γI, Dᵀ], [C, D, -γI]] < 0``:
+        ``P Π₁ = Π₂`` with ``Π₁ = [[Y, I], [Mᵀ, 0]]``, ``Π₂ = [[I, X], [0, Nᵀ]]`` in the
+        frame the controller was formed in (Scherer, Gahinet & Chilali 1997; here ``Y``
+        is :meth:`lyapunov`'s ``X`` and vice versa).  For an independent check of the
+        controller; the test suite differentiates it in ``p``."""
+        p = self.values(*args, **named)
+        R, S = self.lyapunov(*p)
+        c = float(np.sqrt(float(level) * self.scaling.gamma_factor / self.gamma_lmi_scaled))
+        R, S = c * R, c * S
+        T = self.frame if self.rate_bounded else _lmi.balancing_transform(R, S)[0]
+        Ti = np.linalg.inv(T)
+        Yb, Xb = Ti @ R @ Ti.T, T.T @ S @ T
+        n = R.shape[0]
+        I, Z = np.eye(n), np.zeros((n, n))
+        IXY = I - Xb @ Yb
+        N, MT = (IXY, I) if self.rate_bounded and self.rate_form == "Y" else (I, IXY)
+        Pi1 = np.block([[Yb, I], [MT, Z]])
+        Pi2 = np.block([[I, Xb], [Z, N.T]])
+        Pb = np.linalg.solve(Pi1.T, Pi2.T).T
+        J = np.block([[Ti, Z], [Z, I]])
+        return _lmi._sym(J.T @ Pb @ J)
 
     def build(self, *args, **named) -> tuple[control.StateSpace, float, float]:
         """``(K, level, cond_xy)``: the controller at ``p``, the level (plant units) it was
@@ -309,7 +545,9 @@ class ScheduledController:
 
         The level is ``(1 + backoff) γ_lmi`` wherever the projected inequalities hold
         there (on the grid, by construction); between grid points, where they fail, the
-        next of ``_ESCALATION`` times it (said by the returned level)."""
+        first of ``_ESCALATION`` times it where they hold (:meth:`inequalities`; said
+        by the returned level).  The explicit formulas alone do not detect a failed
+        ``S`` inequality (the elimination checks one of its two projections)."""
         p = self.values(*args, **named)
         X, Y = self.lyapunov(*p)
         G = _plant_at(self.plant, p, self.nmeas, self.ncon, self.shape)
@@ -319,6 +557,8 @@ class ScheduledController:
         # iff it exceeds 1 (imposed on the grid only; between grid points of a rich
         # basis it fell to 0.985 on the mass-spring-damper of tests/test_lpv.py)
         # (with X(p) > 0; an indefinite X(p) fails at every level)
+        rates = self.lyapunov_rate(*p)
+        projections = _lmi._projections(Ps, Ps, sparse=False)
         definite = np.linalg.eigvalsh(_lmi._sym(X))[0] > 0.0
         lam = float(np.min(np.linalg.eigvals(X @ Y).real)) if definite else -np.inf
         last = None
@@ -332,8 +572,17 @@ class ScheduledController:
                 last = f"coupling: min eig(X(p) Y(p)) = {lam:.6g} against 1/{c2:.6g}"
                 continue
             c = float(np.sqrt(c2))
+            top = self._top(projections, X, Y, rates, level)
+            if not top < 0.0:
+                last = f"projected inequalities: largest eigenvalue {top:.3g} γ"
+                continue
             try:
-                Ks, cond_xy = _lmi.decoupled_controller(Ps, c * X, c * Y, level)
+                if self.rate_bounded:
+                    key = "dR" if self.rate_form == "X" else "dS"
+                    Ks, cond_xy = _lmi.decoupled_controller(
+                        Ps, c * X, c * Y, level, T=self.frame, **{key: [c * D for D in rates]})
+                else:
+                    Ks, cond_xy = _lmi.decoupled_controller(Ps, c * X, c * Y, level)
             except (SolverError, np.linalg.LinAlgError) as exc:
                 last = exc
                 continue
@@ -345,6 +594,172 @@ class ScheduledController:
     def at(self, *args, **named) -> control.StateSpace:
         """The controller at one parameter value (``K.at(m3=42.0)``)."""
         return self.build(*args, **named)[0]
+
+    def at_discrete(self, *args, dt: float, allow_unresolved: bool = False,
+                    **named) -> control.StateSpace:
+        """The controller at one parameter value, discretised by Tustin's bilinear map at
+        the sample time ``dt`` (s): ``K.at_discrete(dt=1e-3, m3=42.0)``.
+
+        Tustin (python-control's ``sample_system``, method ``"bilinear"``) maps the left
+        half-plane onto the unit disk, so the stable frozen controllers stay stable at
+        any rate, and keeps the frequency response up to the warping
+        ``ω -> (2/dt) tan(ω dt / 2)``.  A controller pole above the Nyquist rate ``π/dt``
+        is compressed below it: the discrete controller is then a different one, and the
+        certified γ says nothing about it.  That is a :class:`NyquistError`, not a
+        warning: a realization for a computer is asked for exactly once per schedule
+        point, nobody reads a log at that moment, and the error names the pole and the
+        rate needed (``allow_unresolved=True`` returns the compressed realization
+        anyway).  ``BACKOFF`` keeps the poles of :func:`lpvsyn`'s controllers below
+        1e3 rad/s on the examples measured, a third of the 1 kHz Nyquist rate.
+
+        Raises
+        ------
+        NyquistError
+            A pole of ``K(p)`` faster than ``π/dt`` (without ``allow_unresolved``).
+        ParameterError
+            ``dt`` not positive, or a parameter value outside the design interval.
+        """
+        dt = finite_scalar(dt, "dt")
+        if dt <= 0:
+            raise ParameterError(f"dt must be a positive number of seconds, got {dt!r}")
+        K = self.at(*args, **named)
+        fast = float(np.max(np.abs(np.linalg.eigvals(K.A)))) if K.nstates else 0.0
+        if fast > np.pi / dt and not allow_unresolved:
+            p = self.values(*args, **named)
+            where = ", ".join(f"{n}={v:.6g}" for n, v in zip(self.names, p))
+            raise NyquistError(f"at {where} the controller has a pole at {fast:.6g} rad/s, "
+                               f"above the Nyquist rate π/dt = {np.pi / dt:.6g} rad/s: "
+                               f"sample faster than dt = {np.pi / fast:.3g} s (or pass "
+                               "allow_unresolved=True)")
+        Kd = control.sample_system(K, dt, method="bilinear")
+        return control.ss(Kd.A, Kd.B, Kd.C, Kd.D, dt)
+
+    def to_dict(self, table: dict | None = None) -> dict:
+        """JSON-ready description (every float a Python float, which :mod:`json` writes
+        as its shortest round-tripping repr: loading is exact).
+
+        The plant and a caller's basis are callables; they are stored as tables on
+        ``table`` (``{name: values}``), by default the plant's own table when it was
+        given as a list of plants, else the design grid cut 4 times finer (the
+        certificate's grid).  :meth:`from_dict` reproduces ``X_i``, ``Y_i``, the
+        scalings and every table bit for bit, so ``at(p)`` of the loaded controller
+        equals the original's bit for bit at every table node; between nodes the loaded
+        controller uses the tables' linear interpolation (exact everywhere when the
+        plant was a list of plants and the basis the default, ``"exact_between_nodes"``).
+        """
+        plant_is_table = isinstance(self.plant, _TablePlant) and table is None
+        if table is not None:
+            names, axes = _axes(table)
+            if names != self.names:
+                raise ParameterError(f"the table's parameters {names} are not {self.names}")
+            # every node inside the design interval (the axes are sorted)
+            self.values(*(float(a[0]) for a in axes))
+            self.values(*(float(a[-1]) for a in axes))
+        elif plant_is_table:
+            axes = self.plant.table.axes
+        elif self.grid is not None:
+            axes = tuple(_check_axes(tuple(np.asarray(self.grid[n], dtype=float)
+                                           for n in self.names), 4))
+        else:
+            raise ParameterError("give the table {name: values} the plant is stored on")
+        nodes = list(itertools.product(*(a.tolist() for a in axes)))
+        if plant_is_table:
+            blocks = [self.plant.table.nodes[p] for p in nodes]
+        else:
+            blocks = []
+            for p in nodes:
+                G = as_statespace(self.plant(*p), f"P{p}")
+                if (G.nstates, G.ninputs, G.noutputs) != tuple(self.shape):
+                    raise DimensionError(f"P{p} does not have the sizes {self.shape}")
+                blocks.append(np.block([[G.A, G.B], [G.C, G.D]]))
+        nb = max(len(self.X), len(self.Y))
+        if isinstance(self.basis, _AffineBasis):
+            basis = {"kind": "affine", "live": list(self.basis.live)}
+        elif isinstance(self.basis, _TableBasis) and table is None:
+            b_axes = self.basis.table.axes
+            b_nodes = list(itertools.product(*(a.tolist() for a in b_axes)))
+            basis = {"kind": "table", "axes": [_floats(a) for a in b_axes],
+                     "values": [_floats(self.basis.table.nodes[p]) for p in b_nodes]}
+            if self.basis.jac is not None:
+                basis["jacobian"] = [_floats(self.basis.jac.nodes[p]) for p in b_nodes]
+        else:
+            basis = {"kind": "table", "axes": [_floats(a) for a in axes],
+                     "values": [_floats(_basis_values(self.basis, p, nb)) for p in nodes]}
+            if self.rate_bounded:
+                # the rate terms of the controller need ∂f/∂p as well
+                basis["jacobian"] = [_floats(_basis_jacobian(self.basis, p, nb))
+                                     for p in nodes]
+        sc = self.scaling
+        return {
+            "names": list(self.names),
+            "bounds": [[float(lo), float(hi)] for lo, hi in self.bounds],
+            "nmeas": int(self.nmeas), "ncon": int(self.ncon),
+            "shape": [int(v) for v in self.shape],
+            "grid": None if self.grid is None else
+            {n: _floats(self.grid[n]) for n in self.names},
+            "X": [_floats(M) for M in self.X], "Y": [_floats(M) for M in self.Y],
+            "gamma_lmi_scaled": float(self.gamma_lmi_scaled), "backoff": float(self.backoff),
+            "scaling": {"T": _floats(sc.T), "Su": _floats(sc.Su), "Sy": _floats(sc.Sy),
+                        "cw": float(sc.cw), "cz": float(sc.cz)},
+            "plant": {"axes": [_floats(a) for a in axes],
+                      "blocks": [_floats(M) for M in blocks]},
+            "basis": basis,
+            "exact_between_nodes": bool(plant_is_table and (
+                basis["kind"] == "affine" or isinstance(self.basis, _TableBasis))),
+            "rate": None if self.rate is None else [float(v) for v in self.rate],
+            "rate_form": self.rate_form,
+            "frame": None if self.frame is None else _floats(self.frame),
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> ScheduledController:
+        """The controller described by :meth:`to_dict` (exactly)."""
+        try:
+            names = tuple(str(n) for n in data["names"])
+            shape = tuple(int(v) for v in data["shape"])
+            plant_axes = [np.asarray(a, dtype=float) for a in data["plant"]["axes"]]
+            nodes = list(itertools.product(*(a.tolist() for a in plant_axes)))
+            blocks = data["plant"]["blocks"]
+            if len(blocks) != len(nodes):
+                raise DimensionError(f"the plant table has {len(blocks)} entries for "
+                                     f"{len(nodes)} nodes")
+            plant = _TablePlant.from_blocks(plant_axes, dict(zip(nodes, blocks)), shape)
+            b = data["basis"]
+            if b["kind"] == "affine":
+                basis = _AffineBasis(b["live"])
+            elif b["kind"] == "table":
+                b_axes = [np.asarray(a, dtype=float) for a in b["axes"]]
+                b_nodes = list(itertools.product(*(a.tolist() for a in b_axes)))
+                if len(b["values"]) != len(b_nodes):
+                    raise DimensionError("the basis table does not match its axes")
+                jac = None if b.get("jacobian") is None else \
+                    _GridTable(b_axes, dict(zip(b_nodes, b["jacobian"])))
+                basis = _TableBasis(_GridTable(b_axes, dict(zip(b_nodes, b["values"]))), jac)
+            else:
+                raise InputError(f"unknown basis kind {b['kind']!r}")
+            sc = data["scaling"]
+            scaling = PlantScaling(np.asarray(sc["T"], dtype=float),
+                                   np.asarray(sc["Su"], dtype=float),
+                                   np.asarray(sc["Sy"], dtype=float),
+                                   float(sc["cw"]), float(sc["cz"]))
+            X = tuple(np.asarray(M, dtype=float) for M in data["X"])
+            Y = tuple(np.asarray(M, dtype=float) for M in data["Y"])
+            grid = None if data.get("grid") is None else \
+                {n: np.asarray(data["grid"][n], dtype=float) for n in names}
+            rate = None if data.get("rate") is None else \
+                tuple(float(v) for v in data["rate"])
+            frame = None if data.get("frame") is None else \
+                np.asarray(data["frame"], dtype=float)
+            return cls(names, tuple((float(lo), float(hi)) for lo, hi in data["bounds"]),
+                       basis, X, Y, float(data["gamma_lmi_scaled"]), float(data["backoff"]),
+                       scaling, plant, int(data["nmeas"]), int(data["ncon"]), shape, grid,
+                       rate, frame, data.get("rate_form"))
+        except KeyError as exc:
+            raise InputError(f"scheduled controller description lacks key {exc}") from exc
+        except (TypeError, ValueError) as exc:
+            if isinstance(exc, InputError):
+                raise
+            raise InputError(f"malformed scheduled controller description: {exc}") from exc
 
 
 # --------------------------------------------------------------------------- result
@@ -385,6 +800,14 @@ class LpvsynResult:
         formed at a higher one (its norm certified all the same).
     seconds, seconds_lmi, seconds_check : float
         Wall time in all, in the γ minimisation and in the check.
+    status : str
+        Clarabel's status of the γ minimisation.
+    inequality_check : numpy.ndarray
+        Certificate (b): at each check point, the largest eigenvalue (relative to the
+        level) of the projected inequalities re-evaluated with the returned ``X(p)``,
+        ``Y(p)`` — with ``-Ẋ(p)`` at every vertex of the rate box for ν > 0 — and of the
+        coupling, as the controller there was formed (:meth:`ScheduledController.inequalities`);
+        negative where they hold, a warning otherwise.
     """
 
     K: ScheduledController
@@ -400,6 +823,7 @@ class LpvsynResult:
     seconds_lmi: float
     seconds_check: float
     status: str = ""
+    inequality_check: np.ndarray = None
 
     def gamma_frozen(self, *args, **named) -> float:
         """``hinfnorm(lft(P(p), K(p)))`` at one parameter value (``inf`` if unstable)."""
@@ -409,19 +833,43 @@ class LpvsynResult:
 
 
 # --------------------------------------------------------------------------- synthesis
-def _gamma_lmi(plants, F, opts: HinfsynOptions, warnings: list):
-    """The γ minimisation over the grid (scaled plants, ``D22 = 0``)."""
+def _gamma_lmi(plants, F, opts: HinfsynOptions, warnings: list, J=None, nus=None,
+               form: str = "X"):
+    """The γ minimisation over the grid (scaled plants, ``D22 = 0``); with the basis
+    Jacobians ``J`` (one ``nb x k`` matrix per grid point) and rate bounds ``nus``, the
+    ``X`` inequality carries ``-Ẋ`` at every vertex of the rate box and ``Y`` is one
+    constant matrix (``form="X"``), or the ``Y`` inequality ``+Ẏ`` and ``X`` is
+    constant (``form="Y"``)."""
     n, nb = plants[0].nstates, F.shape[1]
-    Xs = [cp.Variable((n, n), symmetric=True) for _ in range(nb)]
-    Ys = [cp.Variable((n, n), symmetric=True) for _ in range(nb)]
+    rated = nus is not None and any(nu > 0 for nu in nus)
+    Xs = [cp.Variable((n, n), symmetric=True)
+          for _ in range(1 if rated and form == "Y" else nb)]
+    Ys = [cp.Variable((n, n), symmetric=True)
+          for _ in range(1 if rated and form == "X" else nb)]
     g = cp.Variable(nonneg=True)
     eye = np.eye(n)
     cons = []
-    for Pk, f in zip(plants, F):
-        X = sum(float(fi) * Xi for fi, Xi in zip(f, Xs))
-        Y = sum(float(fi) * Yi for fi, Yi in zip(f, Ys))
+    corners = _vertices(nus) if rated else []
+    for idx, (Pk, f) in enumerate(zip(plants, F)):
+        X = Xs[0] if rated and form == "Y" else sum(float(fi) * Xi for fi, Xi in zip(f, Xs))
+        Y = Ys[0] if rated and form == "X" else sum(float(fi) * Yi for fi, Yi in zip(f, Ys))
         pr, ps = _lmi._projections(Pk, Pk, sparse=False)
-        cons += [p.lmi(V, g, opts.margin) for p, V in ((pr, X), (ps, Y)) if p is not None]
+        for proj, V, Vs, sign, dependent in ((pr, X, Xs, -1.0, form == "X"),
+                                             (ps, Y, Ys, 1.0, form == "Y")):
+            if proj is None:
+                continue
+            if not (rated and dependent):
+                cons.append(proj.lmi(V, g, opts.margin))
+                continue
+            pad = np.zeros((proj.Nx.shape[1], proj.H.shape[1]))
+            for v in corners:
+                w = J[idx] @ v                                  # ∂f/∂p · ṗ
+                terms = [float(wi) * Vi for wi, Vi in zip(w, Vs) if wi]
+                L = proj.matrix(V, g)
+                if terms:
+                    L = L + sign * cp.bmat([[proj.Nx.T @ sum(terms) @ proj.Nx, pad],
+                                            [pad.T, np.zeros((pad.shape[1],) * 2)]])
+                cons.append(_lmi._sym(L) << -opts.margin * np.eye(L.shape[0]))
         cons += [_lmi._sym(cp.bmat([[X, eye], [eye, Y]])) >> 0,
                  cp.trace(X) + cp.trace(Y) <= opts.xy_bound * n]
     prob = cp.Problem(cp.Minimize(g), cons)
@@ -446,10 +894,11 @@ def _check_axes(axes, density: int):
 
 
 def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
-           rate: dict | None = None, backoff: float = BACKOFF, check_density: int = 4,
+           rate: dict | None = None, rate_form: str = "auto", backoff: float = BACKOFF,
+           check_density: int = 4,
            options: HinfsynOptions | None = None) -> LpvsynResult:
-    """Gain-scheduled H∞ output-feedback synthesis on a parameter grid, parameters frozen
-    during operation (rate bound ν = 0).
+    """Gain-scheduled H∞ output-feedback synthesis on a parameter grid, for parameters
+    frozen during operation (ν = 0) or varying at bounded rates ``|ṗ_k| <= ν_k``.
 
     Parameters
     ----------
@@ -467,7 +916,11 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
         ``f(*p) -> sequence`` of the basis functions of ``X(p)`` and ``Y(p)``; the
         default is ``[1]`` and each parameter with more than one grid value.
     rate : dict, optional
-        ``{name: ν}``, the bound on ``|dp/dt|``; only 0 (the default) is built.
+        ``{name: ν}``, the bound on ``|dp/dt|`` (per second; absent names: 0, frozen).
+    rate_form : {"auto", "X", "Y"}
+        With a rate bound: which Lyapunov matrix depends on ``p`` (the other one is
+        constant, so that the controller does not need ``ṗ``); ``"auto"`` solves both
+        LMIs and keeps the lower γ (twice the time).
     backoff : float
         The controller is formed at ``(1 + backoff) γ_lmi`` (see ``BACKOFF``).
     check_density : int
@@ -482,22 +935,23 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
 
     Raises
     ------
-    RateBoundNotBuiltError
-        A nonzero rate bound (ν > 0 is not built yet).
     NonFiniteError, DimensionError, DiscreteTimeError, ParameterError, InputError
-        Bad grid, plant or basis: NaN, an empty grid, discrete-time plants, sizes that
-        change across the grid, a basis of the wrong length, non-finite, or linearly
-        dependent on the grid.
+        Bad grid, plant, basis or rate: NaN, an empty grid, discrete-time plants, sizes
+        that change across the grid, a basis of the wrong length, non-finite, or
+        linearly dependent on the grid, a rate bound on a parameter with one grid
+        value, a negative or non-finite rate.
     InfeasibleError, SolverError
         No scheduled controller exists for this basis, or Clarabel failed.
 
     Notes
     -----
-    The controller is guaranteed for frozen parameters only: for each constant ``p``
-    the loop ``F_l(P(p), K(p))`` is stable with its norm below the level, certified on
-    the check grid; a parameter that varies during operation, however slowly, is not
-    covered (that needs the ``∂X/∂p`` terms of a rate bound ν > 0).  Between check
-    points nothing is certified.
+    With ν = 0 the controller is guaranteed for frozen parameters only: for each
+    constant ``p`` the loop ``F_l(P(p), K(p))`` is stable with its norm below the level,
+    certified on the check grid; a parameter that varies during operation, however
+    slowly, is not covered.  With ν > 0 the parameter-dependent inequalities (with the
+    ``∂X/∂p`` terms at every vertex of the rate box) are re-evaluated on the check grid
+    (``inequality_check``), which bounds the induced L2 gain for varying parameters
+    where they hold.  Between check points nothing is certified.
 
     Examples
     --------
@@ -537,14 +991,20 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
     rate = {} if rate is None else rate
     if not isinstance(rate, dict) or set(rate) - set(names):
         raise ParameterError(f"rate must be a dict over the parameters {names}, got {rate!r}")
-    for name, nu in rate.items():
-        nu = finite_scalar(nu, f"rate[{name!r}]")
+    nus = []
+    for name, a in zip(names, axes):
+        nu = finite_scalar(rate.get(name, 0.0), f"rate[{name!r}]")
         if nu < 0:
             raise ParameterError(f"rate[{name!r}] must be >= 0, got {nu}")
-        if nu > 0:
-            raise RateBoundNotBuiltError(
-                f"rate[{name!r}] = {nu:g}: rate-bounded (ν > 0) LPV synthesis is not built "
-                "yet; only frozen parameters (ν = 0) are")
+        if nu > 0 and a.size < 2:
+            raise ParameterError(f"rate[{name!r}] = {nu:g} but the grid gives {name!r} one "
+                                 "value: a parameter that varies needs a range (at least "
+                                 "two grid values)")
+        nus.append(nu)
+    nus = tuple(nus)
+    rated = any(nu > 0 for nu in nus)
+    if rate_form not in ("auto", "X", "Y"):
+        raise ParameterError(f"rate_form must be 'auto', 'X' or 'Y', got {rate_form!r}")
     basis = _default_basis(axes) if basis is None else basis
     if not callable(basis):
         raise InputError("basis must be a callable f(*p) -> sequence of float")
@@ -556,6 +1016,7 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
                              f"(rank {np.linalg.matrix_rank(F)} over {len(points)} points): "
                              "X(p), Y(p) would not be unique; drop a function or refine "
                              "the grid")
+    J = [_basis_jacobian(basis, p, nb) for p in points] if rated else None
     first = _plant_at(plant, points[0], nmeas, ncon)
     shape = (first.nstates, first.sys.ninputs, first.sys.noutputs)
     if not first.nstates:
@@ -571,16 +1032,45 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
     plants = [_apply_scaling(_without_d22(G), sc) for G in Gs]
     warnings: list[str] = []
     t1 = time.perf_counter()
-    g_s, Xi, Yi, status = _gamma_lmi(plants, F, opts, warnings)
+    notes = []
+    if not rated:
+        g_s, Xi, Yi, status = _gamma_lmi(plants, F, opts, warnings, J, nus)
+        form = None
+    else:
+        forms = ("X", "Y") if rate_form == "auto" else (rate_form,)
+        tried = {}
+        for fm in forms:
+            try:
+                tried[fm] = _gamma_lmi(plants, F, opts, warnings, J, nus, fm)
+            except InfeasibleError:
+                if len(forms) == 1:
+                    raise
+        if not tried:
+            raise InfeasibleError("the rate-bounded LMIs are infeasible with X(p) and with "
+                                  "Y(p) parameter dependent")
+        form = min(tried, key=lambda fm: tried[fm][0])
+        g_s, Xi, Yi, status = tried[form]
+        if len(tried) > 1:
+            notes.append("rate bound: γ_lmi with X(p) (Y constant) "
+                         f"{tried['X'][0] / sc.gamma_factor:.6g}, with Y(p) (X constant) "
+                         f"{tried['Y'][0] / sc.gamma_factor:.6g}; kept {form}(p)")
     t_lmi = time.perf_counter() - t1
+    frame = None
+    if rated:
+        # one frame for the whole range (a frame moving with p would put its derivative
+        # in the controller): the balancing of the middle grid point's pair
+        f_mid = F[len(points) // 2]
+        Xm = Xi[0] if form == "Y" else sum(fi * X for fi, X in zip(f_mid, Xi))
+        Ym = Yi[0] if form == "X" else sum(fi * Y for fi, Y in zip(f_mid, Yi))
+        frame = _lmi.balancing_transform(Xm, Ym)[0]
     K = ScheduledController(tuple(names), tuple((float(a[0]), float(a[-1])) for a in axes),
                             basis, Xi, Yi, g_s, backoff, sc, plant, int(nmeas), int(ncon),
-                            shape)
+                            shape, dict(zip(names, axes)), nus, frame, form)
     gamma_lmi = g_s / sc.gamma_factor
     t2 = time.perf_counter()
     check = _check_axes(axes, int(check_density))
     level0 = gamma_lmi * (1.0 + backoff)
-    norms, levels, escalated = [], [], []
+    norms, levels, escalated, ineq = [], [], [], []
     for p in itertools.product(*(a.tolist() for a in check)):
         where = ", ".join(f"{n}={v:.6g}" for n, v in zip(names, p))
         try:
@@ -589,7 +1079,12 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
             warnings.append(f"at {where}: {exc}")
             norms.append(np.inf)
             levels.append(np.inf)
+            ineq.append(np.inf)
             continue
+        ineq.append(K.inequalities(*p, level=level))
+        if ineq[-1] >= 0.0:
+            warnings.append(f"at {where}: the parameter-dependent inequalities fail with "
+                            f"the returned X(p), Y(p) (largest eigenvalue {ineq[-1]:.3g} γ)")
         if level > level0 * (1.0 + 1e-12):
             escalated.append(where)
         G = _plant_at(plant, p, nmeas, ncon, shape)
@@ -602,7 +1097,6 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
             warnings.append(f"at {where}: certified {gam:.6g} exceeds the LMI's level "
                             f"(1 + backoff) γ_lmi = {level0:.6g} by "
                             f"{100 * (gam / level0 - 1):.3g} %")
-    notes = []
     if escalated:
         notes.append(f"at {len(escalated)} of {len(norms)} check points ({escalated[0]}, "
                         f"...) the grid's LMIs do not hold at the level {level0:.6g}; the "
@@ -613,5 +1107,6 @@ def lpvsyn(P, grid, nmeas: int, ncon: int, *, basis: Callable | None = None,
     return LpvsynResult(K=K, gamma=float(np.max(norms)), gamma_lmi=float(gamma_lmi),
                         grid=dict(zip(names, axes)), check_grid=dict(zip(names, check)),
                         gamma_check=norms, levels=np.asarray(levels),
+                        inequality_check=np.asarray(ineq),
                         warnings=tuple(warnings), notes=tuple(notes), seconds=t3 - t0,
                         seconds_lmi=t_lmi, seconds_check=t3 - t2, status=status)
