@@ -108,7 +108,8 @@ def _stand_in(fail_riccati=False, fail_occupants=False):
             raise OSError("stand-in: mu_occupants.json missing")
         K, weights, u_bound = {"constrained": (K_CONSTRAINED, CONSTRAINED_DESIGN, 4000.0),
                                "refined": (K_REFINED, SeatDesignOptions(), 1500.0),
-                               "occupants": (K_OCCUPANTS, SeatDesignOptions(), 1500.0)}[route]
+                               "occupants": (K_OCCUPANTS, SeatDesignOptions(), 1500.0),
+                               "discrete": (K_REFINED, SeatDesignOptions(), 1500.0)}[route]
         return seat_design_from(route, K, params=None, weights=weights,
                                 figures={"u_bound": u_bound}, seconds=0.0,
                                 description=f"stand-in {route}")

@@ -23,6 +23,7 @@ from lmi_suspension.seat.design import DEFAULT_DESIGN, MuRoute
 from lmi_suspension.seat.multimodel import OccupantRoute
 from lmi_suspension.seat.occupants import OccupantSet, occupant_samples
 from lmi_suspension.seat.refine import RefineRoute, _LIMIT_DT, certify_refined
+from lmi_suspension.seat.discrete_design import DiscreteMuRoute
 from lmi_suspension.seat.routes import (ROUTE_NAMES, SHIPPED_DESIGNS, SeatCertificate,
                                         SeatDesign, SeatRequirements, SeatRoute,
                                         certify_seat, design_seat, load_seat_design,
@@ -44,7 +45,8 @@ def test_every_route_name_gives_its_route():
         route = route_named(name)
         assert isinstance(route, SeatRoute) and route.name == name
     assert {type(route_named(n)) for n in ROUTE_NAMES} == {
-        MuRoute, ConstrainedRoute, RefineRoute, OccupantRoute, PeakBoundedRoute}
+        MuRoute, ConstrainedRoute, RefineRoute, OccupantRoute, PeakBoundedRoute,
+        DiscreteMuRoute}
 
 
 def test_a_route_design_is_the_routes_own_controller_named_and_discretised(peak_bounded):

@@ -79,3 +79,25 @@ def test_the_seat_designed_at_1_khz():
     # and the sampled-data loop on the bump with the exact delay stays stable
     for delay in (0.0, 0.025):
         assert simulate_sampled(d.K, bump(), delay=delay).stable
+
+
+def test_the_shipped_1_khz_design_is_discrete_first_and_certified():
+    from lmi_suspension.lti import freqresp, lft, tustin
+    from lmi_suspension.mu import mussv
+    from lmi_suspension.seat.routes import load_seat_design, route_named
+
+    d = load_seat_design("discrete")
+    assert d.primary == "discrete" and d.Kd.dt == DT
+    assert route_named("discrete").name == "discrete"
+    # K is the bilinear image of Kd: its Tustin map gives Kd back
+    back = tustin(d.K, DT)
+    z = np.exp(1j * np.array([0.3, 30.0, 3000.0]) * DT)
+    np.testing.assert_allclose(np.asarray(back(z)), np.asarray(d.Kd(z)), rtol=1e-9)
+    # µ of the sampled loop recomputed on the unit circle: the file's figure (0.8698)
+    P = sampled_augmented_plant(DT)
+    CL = lft(P.P, d.Kd, P.nmeas, P.ncon)
+    w = np.geomspace(0.1, 0.999 * np.pi / DT, 400)
+    mu = mussv(freqresp(CL, w), P.blk)
+    assert np.max(mu.upper) <= d.figures["mu_peak_upper"] * (1 + 1e-3) < 1
+    # every whole-sample delay 0-25 ms, exactly
+    assert integer_delay_radii(d.Kd, np.arange(26)).max() < 1

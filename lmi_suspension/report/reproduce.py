@@ -45,7 +45,7 @@ logger = logging.getLogger(__name__)
 
 #: Names of the compared controllers, in table order.
 CONTROLLER_NAMES = ("passive", "hinf_lmi_nominal", "hinf_riccati", "mu", "mu_constrained",
-                    "mu_refined", "mu_occupants")
+                    "mu_refined", "mu_occupants", "mu_1khz")
 #: the controller written to ``controller.json`` (the one ``simulate``, ``sweep`` and a
 #: user take): the shipped design for every occupant, spring and delay of the set
 #: (:data:`~lmi_suspension.seat.multimodel.SHIPPED_OCCUPANTS`); the µ design where it
@@ -55,14 +55,14 @@ EXPORTED = "mu_occupants"
 #: message that does not start with a space (details follow indented), and its wall time
 #: is ``summary.json``'s ``timings[name]``
 STAGES = ("mu_design", "mu_analysis", "mu_constrained", "mu_refined", "mu_occupants",
-          "hinf_lmi_nominal", "hinf_riccati",
+          "mu_1khz", "hinf_lmi_nominal", "hinf_riccati",
           "limit",
           *(f"simulate_{n}" for n in CONTROLLER_NAMES), "iso_C", "monte_carlo",
           "occupant_map", "worst_seats", "figures")
 _LONG_NAMES = {"passive": "passive", "hinf_lmi_nominal": "H∞ LMI (no delay)",
                "hinf_riccati": "H∞ Riccati", "mu": "µ (D-K)",
                "mu_constrained": "µ, hard bounds", "mu_refined": "µ, refined",
-               "mu_occupants": "µ, every occupant"}
+               "mu_occupants": "µ, every occupant", "mu_1khz": "µ at 1 kHz"}
 #: sample time of every controller's discrete realization in controllers/<name>.json
 _SAMPLE_TIME = 1e-3
 
@@ -451,8 +451,12 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     :func:`~lmi_suspension.seat.constrained.design_constrained_mu`) takes minutes, so the
     shipped one is loaded and re-certified here (µ bounds, worst-case force and stroke,
     poles), and simulated like the others, also as its 1 kHz sampled-data loop; so are the
-    refined controller (``mu_refined``) and the controller for every occupant
-    (``mu_occupants``, four refinement rounds of 8 to 14 minutes each).
+    refined controller (``mu_refined``), the controller for every occupant
+    (``mu_occupants``, four refinement rounds of 8 to 14 minutes each) and the µ design
+    made on the plant sampled at 1 kHz (``mu_1khz``,
+    :class:`~lmi_suspension.seat.discrete_design.DiscreteMuRoute`: its file's discrete
+    realization is the controller, ``A``–``D`` its bilinear image; its sampled-data loop is
+    what runs).
 
     Parameters
     ----------
@@ -580,6 +584,10 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     occupants = shipped(
         "mu_occupants", "occupants", "seat controller for every occupant, spring and "
         "delay of the set (shipped, re-certified) ...", lambda c: "")
+    # designed at 1 kHz: its discrete realization is the controller, K its bilinear image
+    at_1khz = shipped(
+        "mu_1khz", "discrete", "µ design on the plant sampled at 1 kHz (shipped, "
+        "re-certified) ...", lambda c: "")
 
     # --- comparison controllers ------------------------------------------------------
     controllers: dict[str, object] = {"passive": None}
@@ -594,7 +602,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     controllers["mu"] = mu_design.K
     discrete = {}
     for name, loaded in (("mu_constrained", constrained), ("mu_refined", refined),
-                         ("mu_occupants", occupants)):
+                         ("mu_occupants", occupants), ("mu_1khz", at_1khz)):
         if loaded is not None:
             controllers[name], discrete[name] = loaded[0].K, loaded[0].Kd
 
@@ -744,7 +752,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         Kd = discrete.get(name) or discretise_controller(K, _SAMPLE_TIME,
                                                          warn_unresolved=False)
         loaded = {"mu_constrained": constrained, "mu_refined": refined,
-                  "mu_occupants": occupants}.get(name)
+                  "mu_occupants": occupants, "mu_1khz": at_1khz}.get(name)
         meta = dict(metadata) if name == "mu" else (
             loaded[0].metadata() if loaded is not None else
             {"description": f"{_LONG_NAMES[name]}: y = [x1, x3] (m) -> u (N)"})
@@ -934,7 +942,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
             # judged without the bump (simulated above with every controller)
             "requirements_not_met": list(loaded[1].failures())}
            for name, loaded in (("mu_constrained", constrained), ("mu_refined", refined),
-                                ("mu_occupants", occupants))},
+                                ("mu_occupants", occupants), ("mu_1khz", at_1khz))},
         "exported": exported,
         "occupant_map": map_data,
         "timings": timings,

@@ -21,11 +21,14 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass
+from pathlib import Path
+from typing import ClassVar
 
 import control
 import numpy as np
 
 from ..errors import ParameterError
+from ..lti.bilinear import tustin_image
 from ..lti.checks import as_statespace, positive_scalar, sample_time
 from ..mu import MusynOptions, MusynResult, musyn
 from .augmented import SeatAugmentedPlant, SeatDesignOptions, seat_augmented_plant
@@ -34,8 +37,12 @@ from .model import seat_model
 from .params import SeatParameters
 from .sampled import DEFAULT_SAMPLE_TIME
 
-__all__ = ["SeatDiscreteDesign", "design_discrete_mu_controller", "integer_delay_radii",
-           "sampled_augmented_plant"]
+__all__ = ["DiscreteMuRoute", "SHIPPED_DISCRETE", "SeatDiscreteDesign",
+           "design_discrete_mu_controller", "integer_delay_radii", "sampled_augmented_plant"]
+
+#: the shipped design (``DiscreteMuRoute().design`` at the nominal seat, seed 0; its D-K
+#: takes about a minute, so ``reproduce`` loads and re-certifies it)
+SHIPPED_DISCRETE = Path(__file__).parent / "data" / "mu_1khz.json"
 
 logger = logging.getLogger(__name__)
 
@@ -180,3 +187,40 @@ def design_discrete_mu_controller(dt: float = DEFAULT_SAMPLE_TIME,
                               mu_lower_peak=res.mu_lower_peak,
                               delay_radii=tuple(float(r) for r in radii), dt=dt,
                               seconds=seconds)
+
+
+@dataclass(frozen=True)
+class DiscreteMuRoute:
+    """µ-synthesis at the board's sample rate (:func:`design_discrete_mu_controller`) as a
+    :class:`~.routes.SeatRoute`; the design's ``Kd`` is the controller, ``K`` its bilinear
+    image (``primary == "discrete"``).
+
+    Examples
+    --------
+    >>> DiscreteMuRoute().name, DiscreteMuRoute().dt
+    ('discrete', 0.001)
+    """
+
+    name: ClassVar[str] = "discrete"
+    dt: float = DEFAULT_SAMPLE_TIME
+    design_options: SeatDesignOptions | None = None
+    musyn_options: MusynOptions | None = None
+
+    def design(self, params: SeatParameters, *, rng: np.random.Generator, progress=None):
+        """:func:`design_discrete_mu_controller` at ``params``, as a
+        :class:`~.routes.SeatDesign`."""
+        from .routes import seat_design_from
+
+        d = design_discrete_mu_controller(self.dt, self.design_options, params=params,
+                                          musyn_options=self.musyn_options, rng=rng)
+        if progress is not None:
+            progress(f"µ {d.mu_peak:.4f} at {1 / d.dt:g} Hz, K order {d.K.nstates}")
+        return seat_design_from(
+            self.name, tustin_image(d.K), Kd=d.K, primary="discrete", params=params,
+            weights=d.aug.options, seconds=d.seconds, detail=d,
+            description=f"µ-synthesis at {1 / d.dt:g} Hz (D-K on the sampled plant): "
+                        "y = [x1, x3] (m) -> u (N)",
+            figures={"mu_peak_upper": d.mu_peak, "mu_peak_lower": d.mu_lower_peak,
+                     "stop_reason": d.musyn.stop_reason,
+                     "delay_radius_max": float(max(d.delay_radii)),
+                     "delay_samples": len(d.delay_radii) - 1})

@@ -49,6 +49,7 @@ from .augmented import SeatDesignOptions
 from .bounded import PeakBoundedRoute
 from .constrained import CONSTRAINED_DESIGN, SHIPPED_CONTROLLER, ConstrainedRoute
 from .design import DEFAULT_DESIGN, MuRoute
+from .discrete_design import SHIPPED_DISCRETE, DiscreteMuRoute
 from .multimodel import SHIPPED_OCCUPANTS, OccupantRoute
 from .params import SeatParameters
 from .refine import REFINE_DELAYS, SHIPPED_REFINED, RefineRoute
@@ -60,7 +61,8 @@ __all__ = ["SeatRoute", "SeatDesign", "SeatRequirements", "SeatCertificate", "RO
 logger = logging.getLogger(__name__)
 
 _ROUTES = MappingProxyType({route.name: route for route in (
-    MuRoute, ConstrainedRoute, RefineRoute, OccupantRoute, PeakBoundedRoute)})
+    MuRoute, ConstrainedRoute, RefineRoute, OccupantRoute, PeakBoundedRoute,
+    DiscreteMuRoute)})
 #: the routes shipped with the package, by name (:func:`route_named`)
 ROUTE_NAMES = tuple(_ROUTES)
 
@@ -69,7 +71,8 @@ ROUTE_NAMES = tuple(_ROUTES)
 #: it takes seconds and ``reproduce`` runs it.
 SHIPPED_DESIGNS = MappingProxyType({"constrained": SHIPPED_CONTROLLER,
                                     "refined": SHIPPED_REFINED,
-                                    "occupants": SHIPPED_OCCUPANTS})
+                                    "occupants": SHIPPED_OCCUPANTS,
+                                    "discrete": SHIPPED_DISCRETE})
 
 
 @runtime_checkable
@@ -99,10 +102,12 @@ class SeatDesign:
         The route's name.
     K : control.StateSpace
         Continuous-time controller from ``y = [x1, x3]`` (m) to ``u`` (N, sign of eq. 1),
-        inputs ``['x1', 'x3']``, output ``['u']``.
+        inputs ``['x1', 'x3']``, output ``['u']``; for a design made in discrete time
+        (``primary == "discrete"``), the bilinear image of ``Kd``
+        (:func:`~lmi_suspension.lti.tustin_image`), whose Tustin map is ``Kd``.
     Kd : control.StateSpace
         Its 1 kHz realization (Tustin, :func:`~.sampled.discretise_controller`), the one
-        a seat's controller runs.
+        a seat's controller runs; the design itself where ``primary == "discrete"``.
     params : SeatParameters
         The seat it was designed for.
     weights : SeatDesignOptions
@@ -116,6 +121,9 @@ class SeatDesign:
         One line: the route and what it asked for.
     seconds : float
         Wall time of the design (as saved, for a loaded design).
+    primary : str
+        ``"continuous"`` (designed in continuous time, ``Kd`` its Tustin map) or
+        ``"discrete"`` (designed at ``Kd.dt``, ``K`` its bilinear image).
     detail : object
         The route's own result (:class:`~.design.SeatMuDesign`, ...): its history and
         everything only that route has; None for a design read from a file.
@@ -134,6 +142,7 @@ class SeatDesign:
     description: str = ""
     seconds: float = 0.0
     detail: object = field(default=None, compare=False, repr=False)
+    primary: str = "continuous"
 
     def metadata(self) -> dict:
         """What :func:`save_seat_design` writes beside the controller: the figures, the
@@ -141,8 +150,10 @@ class SeatDesign:
         discretisation."""
         return {**self.figures, "route": self.route, "description": self.description,
                 "params": asdict(self.params), "weights": asdict(self.weights),
-                "design_seconds": self.seconds,
-                "discretisation": f"Tustin, dt = {self.Kd.dt} s"}
+                "design_seconds": self.seconds, "primary": self.primary,
+                "discretisation": (f"Tustin, dt = {self.Kd.dt} s" if self.primary ==
+                                   "continuous" else f"designed at dt = {self.Kd.dt} s; A, B, "
+                                   "C, D are its bilinear image")}
 
     def certify(self, **kwargs) -> "SeatCertificate":
         """:func:`certify_seat` of this design's controllers at its seat, with its µ
@@ -155,7 +166,8 @@ class SeatDesign:
 def seat_design_from(route: str, K: control.StateSpace, *, params: SeatParameters | None,
                      weights: SeatDesignOptions | None, figures: Mapping, description: str,
                      seconds: float, detail=None,
-                     Kd: control.StateSpace | None = None) -> SeatDesign:
+                     Kd: control.StateSpace | None = None,
+                     primary: str = "continuous") -> SeatDesign:
     """A :class:`SeatDesign` with the controller named as the seat's and its 1 kHz
     realization (a route's ``design`` ends with it)."""
     from .sampled import discretise_controller
@@ -171,7 +183,7 @@ def seat_design_from(route: str, K: control.StateSpace, *, params: SeatParameter
                       params=SeatParameters() if params is None else params,
                       weights=_default_weights(route) if weights is None else weights,
                       figures=_jsonable(dict(figures)), description=description,
-                      seconds=float(seconds), detail=detail)
+                      seconds=float(seconds), detail=detail, primary=primary)
 
 
 def route_named(name: str) -> SeatRoute:
@@ -561,7 +573,7 @@ def save_seat_design(path, d: SeatDesign) -> Path:
 
 
 _META_KEYS = ("route", "description", "params", "weights", "design_seconds",
-              "discretisation")
+              "discretisation", "primary")
 
 
 def _default_weights(route: str) -> SeatDesignOptions:
@@ -609,4 +621,5 @@ def load_seat_design(path_or_route, *, route: str | None = None) -> SeatDesign:
     return SeatDesign(route=str(name), K=K, Kd=Kd, params=params, weights=weights,
                       figures={k: v for k, v in meta.items() if k not in _META_KEYS},
                       description=str(meta.get("description", "")),
-                      seconds=float(meta.get("design_seconds", math.nan)))
+                      seconds=float(meta.get("design_seconds", math.nan)),
+                      primary=str(meta.get("primary", "continuous")))
