@@ -54,7 +54,7 @@ import scipy.sparse as sp
 
 from ..errors import DimensionError, InputError
 from ..lti.checks import as_finite_array
-from .blocks import BlockKind, BlockStructure
+from ..umodel.blocks import BlockKind, BlockStructure
 from .timelimit import TimeLimited
 
 __all__ = ["MussvOptions", "MussvResult", "MussvTimings", "mussv"]

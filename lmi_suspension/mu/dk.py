@@ -40,7 +40,7 @@ from ..lti.checks import as_finite_array
 from ..lti.norms import freqresp, hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
 from ..lti.scaling import balanced_statespace
-from .blocks import BlockStructure
+from ..umodel.blocks import BlockStructure
 from .dsearch import search_dscales
 from .interval import interval_bound
 from .steps import DKSteps, block_sizes, certificates, mu_part
@@ -893,8 +893,8 @@ def _previous_level(nxt, setup) -> float:
 def _with_uncertainty(P, blk, nmeas: int, ncon: int):
     """``(P, blk)`` of a certain plant as given; of an uncertain one, its ``lftdata``
     with the full performance block appended."""
-    from ..uncertain.lfr import _Uncertain
-    from ..uncertain.uss import lftdata
+    from ..umodel.lfr import _Uncertain
+    from ..umodel.uss import lftdata
 
     if not isinstance(P, _Uncertain):
         if blk is None:

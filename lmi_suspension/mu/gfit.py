@@ -48,7 +48,7 @@ import control
 import numpy as np
 
 from ..errors import DimensionError, SolverError
-from .blocks import BlockStructure
+from ..umodel.blocks import BlockStructure
 
 logger = logging.getLogger(__name__)
 

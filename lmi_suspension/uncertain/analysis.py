@@ -54,10 +54,10 @@ import scipy.optimize
 from ..errors import AssumptionError, InputError
 from ..lti.norms import hinfnorm
 from ..mu import MussvOptions, mussv
-from ..mu.blocks import BlockStructure
-from .atoms import UComplex, UReal, ULTIDyn
-from .lfr import USS, as_uncertain
-from .uss import usubs
+from ..umodel.blocks import BlockStructure
+from ..umodel.atoms import UComplex, UReal, ULTIDyn
+from ..umodel.lfr import USS, as_uncertain
+from ..umodel.uss import usubs
 
 __all__ = ["RobstabResult", "WcgainResult", "robstab", "wcgain"]
 
@@ -956,5 +956,5 @@ def wcgain(usys, omega=None, *, rng: np.random.Generator | None = None) -> Wcgai
 
 
 def _nominal_ss(x):
-    from .uss import nominal
+    from ..umodel.uss import nominal
     return nominal(x)
