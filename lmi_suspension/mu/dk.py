@@ -620,7 +620,8 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
                                                    first=best is None)
         if failure is not None:
             stop_reason = f"K-step failed at iteration {it}: {failure}"
-            logger.warning("musyn: %s; keeping the best so far", stop_reason)
+            # a stop, told in ``stop_reason``; the best iterate is certified as ever
+            logger.info("musyn: %s; keeping the best so far", stop_reason)
             break
         K = syn.K
         t1 = time.perf_counter()
@@ -673,7 +674,7 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
             except LmiSuspensionError as exc:
                 # no usable scaled plant for the next K-step: end with the best iterate
                 done = f"D-fit failed after iteration {it}: {exc}"
-                logger.warning("musyn: %s; keeping iteration %d", done, best[2])
+                logger.info("musyn: %s; keeping iteration %d", done, best[2])
         t4 = time.perf_counter()
         record = MusynIteration(
             index=it, gamma=float(syn.gamma), mu_peak=mu_peak,
@@ -846,7 +847,7 @@ def _done(setup, it: int, mu_peak: float, gamma: float, gamma_prev: float,
         done = (f"the K-step at iteration {it} is worse on the scaled plant than the "
                 f"previous controller (gamma {gamma:.4f} > {gamma_prev:.4f}): it has lost "
                 "accuracy on this scaled plant")
-        logger.warning("musyn: %s", done)
+        logger.info("musyn: %s", done)
         return done
     if since_best >= opts.patience:
         return f"no improvement of {opts.min_improvement:.1%} in {opts.patience} iterations"

@@ -8,10 +8,10 @@ the :class:`BlockStructure` of Δ), :func:`usubs`, :func:`usample`, :func:`nomin
 and these names together are :mod:`lmi_suspension.uncertain`, the users' import path.
 """
 
+from .atoms import UComplex, ULTIDyn, UReal, ucomplex, ultidyn, ureal
 from .blocks import Block, BlockKind, BlockStructure
-from .atoms import UComplex, UReal, ULTIDyn, ucomplex, ultidyn, ureal
 from .lfr import USS, UBlock, UMat, umat
-from .uss import LFTData, connect, feedback, lftdata, nominal, uss, usample, usubs
+from .uss import LFTData, connect, feedback, lftdata, nominal, usample, uss, usubs
 
 __all__ = [
     "Block", "BlockKind", "BlockStructure",

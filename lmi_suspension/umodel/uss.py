@@ -16,9 +16,9 @@ import control
 import numpy as np
 
 from ..errors import DimensionError, InputError, NonFiniteError, ParameterError
-from .blocks import BlockStructure
 from .atoms import UComplex, UReal
-from .lfr import USS, UBlock, UMat, _Uncertain, _build, as_uncertain, interconnect_parts
+from .blocks import BlockStructure
+from .lfr import USS, UBlock, UMat, _build, _Uncertain, as_uncertain, interconnect_parts
 
 __all__ = ["LFTData", "uss", "feedback", "connect", "lftdata", "usubs", "usample", "nominal"]
 

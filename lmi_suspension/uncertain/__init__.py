@@ -9,8 +9,25 @@ stands on µ; this package, above both, hands on the names of both.
 """
 
 from ..umodel import (
-    USS, LFTData, UBlock, UComplex, ULTIDyn, UMat, UReal, connect, feedback, lftdata, nominal,
-    ucomplex, ultidyn, umat, ureal, usample, uss, usubs)
+    USS,
+    LFTData,
+    UBlock,
+    UComplex,
+    ULTIDyn,
+    UMat,
+    UReal,
+    connect,
+    feedback,
+    lftdata,
+    nominal,
+    ucomplex,
+    ultidyn,
+    umat,
+    ureal,
+    usample,
+    uss,
+    usubs,
+)
 from .analysis import RobstabResult, WcgainResult, robstab, wcgain
 
 __all__ = [
