@@ -85,7 +85,7 @@ def test_a_short_musyn_is_quiet_and_its_iterates_are_certified(caplog):
     assert again.upper == pytest.approx(res.mu_peak, rel=1e-3)
 
 
-@pytest.mark.slow  # 38 s on Zen 1 (2026-12-02): the second tier
+@pytest.mark.slow  # 41 s on Zen 1 (2026-12-02): the second tier
 def test_default_musyn_on_distillation_is_quiet(caplog):
     """The run that used to print "scaled peak ... exceeds (1+rtol)*mu_peak" (a D-fit of
     iteration 2 short of its tolerance, which the next D-step's bound accounts for)."""
