@@ -429,6 +429,11 @@ def test_options_are_validated_and_frozen():
             MusynOptions(dscale_overrelax=alpha)
     with pytest.raises(ParameterError, match="dscale_search"):
         MusynOptions(dscale_search=-1)
+    for order in ("least", -1, True):
+        with pytest.raises(ParameterError, match="reduce_order"):
+            MusynOptions(reduce_order=order)
+    with pytest.raises(ParameterError, match="reduce_mu_tol"):
+        MusynOptions(reduce_mu_tol=-0.01)
     opts = MusynOptions()
     with pytest.raises(dataclasses.FrozenInstanceError):
         opts.max_iter = 3
@@ -1144,3 +1149,28 @@ def test_final_bounds_peak_is_the_lmi_bound_peak(monkeypatch):
     assert final.peak == pytest.approx(float(np.max(exact.upper)), rel=1e-6)
     assert np.all(np.asarray(final.upper) <= np.asarray(fast.upper) * (1 + 1e-12))
     assert np.all(np.asarray(final.lower) <= np.asarray(final.upper))
+
+
+@pytest.mark.slow  # 23 s on Zen 1 (2026-12-02): the second tier
+def test_auto_order_reduction_keeps_mu_within_its_tolerance():
+    """reduce_order="auto" on two D-K iterations of distillation (a 22-state controller):
+    the returned controller is a balanced truncation of the full-order one, kept in
+    the result, and its µ -- recomputed here by mussv on both loops over the same dense
+    grid -- is within reduce_mu_tol of the full order's."""
+    ex = skogestad_distillation()
+    tol = 0.01
+    res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk,
+                options=MusynOptions(max_iter=2, dscale_search=0, reduce_order="auto",
+                                     reduce_mu_tol=tol))
+    assert res.K_full is not None and res.reduced_from == res.K_full.nstates
+    assert res.K.nstates < res.K_full.nstates
+    assert np.all(res.CL.poles().real < 0)
+    w = np.logspace(-3, 3, 200)
+    mu = {name: float(np.max(mussv(freqresp(lft(ex.P, K, ex.nmeas, ex.ncon), w),
+                                   ex.blk).upper))
+          for name, K in (("reduced", res.K), ("full", res.K_full))}
+    # 200 points against the result's dense grid: the peaks agree to 1 % (a flat µ)
+    assert mu["full"] == pytest.approx(res.mu_peak_full, rel=0.01)
+    assert mu["reduced"] == pytest.approx(res.mu_peak, rel=0.01)
+    assert res.mu_peak <= res.mu_peak_full * (1 + tol)
+    assert res.mu_bound >= res.mu_peak * (1 - 1e-9)

@@ -7,6 +7,7 @@ two-record D-K history) so that these tests check the pipeline, not the synthesi
 import importlib
 import json
 import math
+import warnings
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -507,10 +508,16 @@ def test_design_facts_are_in_the_summary_not_in_warnings(monkeypatch, tmp_path, 
     designs: the summary (summary.json, the table) states them, no warning is logged."""
     api, *_ = _stand_in()
     monkeypatch.setattr(R, "_design_api", lambda: api)
-    with caplog.at_level("WARNING"):
+    with caplog.at_level("WARNING"), warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         summary = R.reproduce(tmp_path, rng=np.random.default_rng(0), delays=(0.0,),
                               quick=True)
     assert not [r for r in caplog.records if r.levelname == "WARNING"], caplog.text
+    # nor a Python warning (a third party's DeprecationWarning about itself is not shown)
+    shown = [f"{w.category.__name__} {w.filename}:{w.lineno}: {w.message}" for w in caught
+             if not (issubclass(w.category, DeprecationWarning)
+                     and "lmi_suspension" not in w.filename)]
+    assert shown == []
     c = summary.controller("hinf_lmi_nominal")
     assert c.fastest_pole == pytest.approx(FAST_POLE)
     pole_facts = [f for f in summary.facts if "Nyquist rate 3142 rad/s" in f]

@@ -4,7 +4,7 @@ block structures -> bounds (``mussv``, over intervals ``interval_bound``) -> rat
 -> direct D-scale search (``search_dscales``, run by ``musyn`` from the first iterate).
 """
 
-from .blocks import Block, BlockKind, BlockStructure
+from ..umodel.blocks import Block, BlockKind, BlockStructure
 from .bounds import MussvOptions, MussvResult, MussvTimings, mussv
 from .dfit import DScaleFit, fit_dscales, fit_magnitude, scaled_plant
 from .dsearch import DScaleSearchResult, search_dscales

@@ -54,7 +54,7 @@ import scipy.sparse as sp
 
 from ..errors import DimensionError, InputError
 from ..lti.checks import as_finite_array
-from .blocks import BlockKind, BlockStructure
+from ..umodel.blocks import BlockKind, BlockStructure
 from .timelimit import TimeLimited
 
 __all__ = ["MussvOptions", "MussvResult", "MussvTimings", "mussv"]
@@ -78,6 +78,9 @@ _LMI_RECOVERY_REG = (1e-7, 1e-6, 1e-5)
 #: the next decades: 0.41-0.46 after 3-5 passes, against lower bounds of 0.4 (the
 #: same matrices).  A pass runs only while the gap to the lower bound is open.
 _LMI_PASSES = 6
+#: a lower bound above the upper one by more than this (relative) is no round-off: one
+#: of the two is wrong.  Both are clipped equal either way; beyond it the result says so
+_CROSS_RTOL = 1e-8
 #: AB13MD's value is taken where the numpy check of its scalings confirms it to this
 #: relative margin (they agreed to 1e-9 on the seat's occupant structure)
 _AB13MD_CONFIRM = 1e-6
@@ -194,6 +197,10 @@ class MussvResult:
         ``"ab13md"``, a frequency it failed at used ``"lmi"``; the log says so at INFO).
     timings : MussvTimings
         Wall-clock seconds.
+    warnings : tuple of str
+        What the bounds could not honour: a lower bound above the upper one beyond
+        round-off (it is clipped to the upper bound; one of the two is numerically
+        wrong there).  Each is also logged at WARNING.
     """
 
     upper: float | np.ndarray
@@ -209,6 +216,7 @@ class MussvResult:
     blk: BlockStructure
     method: str
     timings: MussvTimings = field(repr=False)
+    warnings: tuple[str, ...] = ()
 
     def __iter__(self):
         return iter((self.upper, self.lower))
@@ -539,6 +547,14 @@ class _LmiBound:
         # The problem saw M/β with β² = 1: its G multiplies M/β, so G(M) = β G(M/β).
         G = G * scale
         return _certify(M, XL, XR, G), (XL, XR, G)
+
+
+def _crossed(lower: float, upper: float, k: int) -> str:
+    """The note, logged at WARNING, of a lower bound clipped to the upper one at ``k``."""
+    msg = (f"mussv: lower bound {lower:.10g} exceeds upper bound {upper:.10g} at index "
+           f"{k}; clipped")
+    logger.warning(msg)
+    return msg
 
 
 def _certify(M, XL, XR, G):
@@ -1078,6 +1094,7 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
     use = "fast" if (method == "fast" or (method == "auto" and fast_ok)) else (
         "ab13md" if ab_blocks is not None else "lmi")
     fallbacks = 0
+    notes: list[str] = []  # MussvResult.warnings
 
     nout, nin, nf = stack.shape
     m = struct.n_blocks
@@ -1177,12 +1194,8 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
             for i, (b, cs) in enumerate(zip(struct.blocks, struct.col_slices())):
                 dblk[i, k] = np.sqrt(max(np.real(np.trace(XR[cs, cs])) / b.rows, 0.0))
             if lo_val > ub:
-                # Equal bounds can cross by round-off; anything larger is a numerical problem.
-                if lo_val > ub * (1 + 1e-8):
-                    warnings.warn(
-                        f"mussv: lower bound {lo_val:.10g} exceeds upper bound {ub:.10g} at index {k}; clipped",
-                        RuntimeWarning, stacklevel=2,
-                    )
+                if lo_val > ub * (1 + _CROSS_RTOL):
+                    notes.append(_crossed(lo_val, ub, k))
                 lo_val = ub
             upper[k], lower[k] = ub, lo_val
             if lo_delta is not None:
@@ -1194,10 +1207,8 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
     if batch:
         t0 = time.perf_counter()
         lower, dlt = _power_lower_full_batch(stack, struct, rng, opts, DL, DR, upper)
-        for k in np.flatnonzero(lower > upper * (1 + 1e-8)):
-            # equal bounds can cross by round-off; anything larger is a numerical problem
-            warnings.warn(f"mussv: lower bound {lower[k]:.10g} exceeds upper bound "
-                          f"{upper[k]:.10g} at index {k}; clipped", RuntimeWarning, stacklevel=2)
+        notes += [_crossed(lower[k], upper[k], k)
+                  for k in np.flatnonzero(lower > upper * (1 + _CROSS_RTOL))]
         lower = np.minimum(lower, upper)
         delta = np.moveaxis(dlt, 0, -1)
         t_lo += time.perf_counter() - t0
@@ -1215,9 +1226,10 @@ def mussv(M, blk, *, method: str = "auto", omega=None, rng=None, options: MussvO
             upper=float(upper[0]), lower=float(lower[0]), omega=omega,
             D_left=DL[:, :, 0], D_right=DR[:, :, 0], G=G[:, :, 0], d_blocks=dblk[:, 0],
             delta=delta[:, :, 0], peak=peak, peak_omega=peak_omega, blk=struct,
-            method=use, timings=timings,
+            method=use, timings=timings, warnings=tuple(notes),
         )
     return MussvResult(
         upper=upper, lower=lower, omega=omega, D_left=DL, D_right=DR, G=G, d_blocks=dblk,
         delta=delta, peak=peak, peak_omega=peak_omega, blk=struct, method=use, timings=timings,
+        warnings=tuple(notes),
     )

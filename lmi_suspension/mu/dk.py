@@ -40,7 +40,7 @@ from ..lti.checks import as_finite_array, sample_time
 from ..lti.norms import freqresp, hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
 from ..lti.scaling import balanced_statespace
-from .blocks import BlockStructure
+from ..umodel.blocks import BlockStructure
 from .dsearch import search_dscales
 from .interval import interval_bound
 from .steps import DKSteps, block_sizes, certificates, mu_part
@@ -152,9 +152,12 @@ class MusynOptions:
         returned controller's µ is re-computed (the reported ``mu_peak``); the grid also
         extends, 4 points per decade, to three decades below the closed loop's slowest
         pole and two above its fastest.
-    reduce_order : int or None
-        If set, try a balanced truncation of the best controller to this order and keep it
-        when its µ peak stays within ``reduce_mu_tol`` (relative) of the full-order one.
+    reduce_order : int, "auto" or None
+        If an order, try a balanced truncation of the best controller to this order and
+        keep it when its loop is stable, meets the constraints, and its µ peak stays
+        within ``reduce_mu_tol`` (relative) of the full-order one.  ``"auto"``: the
+        least such order (found by bisection).  The full-order controller is kept in
+        :attr:`MusynResult.K_full`.
     reduce_mu_tol : float
         Relative µ increase tolerated by the order reduction.
     stop_on_kstep_regression : bool
@@ -249,7 +252,7 @@ class MusynOptions:
     max_dfit_order: int = 4
     dfit_rtol: float = 0.03
     n_dense: int = 400
-    reduce_order: int | None = None
+    reduce_order: int | str | None = None
     reduce_mu_tol: float = 0.02
     stop_on_kstep_regression: bool = True
     dscale_overrelax: float = 2.0
@@ -266,8 +269,12 @@ class MusynOptions:
             raise ParameterError("mu_target, min_improvement must be >= 0 and dfit_rtol > 0")
         if int(self.max_dfit_order) < 0 or int(self.n_dense) < 10:
             raise ParameterError("max_dfit_order must be >= 0 and n_dense >= 10")
-        if self.reduce_order is not None and int(self.reduce_order) < 0:
-            raise ParameterError("reduce_order must be >= 0")
+        if self.reduce_order is not None and self.reduce_order != "auto" and (
+                isinstance(self.reduce_order, (str, bool)) or int(self.reduce_order) < 0):
+            raise ParameterError(f"reduce_order must be None, 'auto' or an order >= 0, "
+                                 f"got {self.reduce_order!r}")
+        if not (np.isfinite(self.reduce_mu_tol) and self.reduce_mu_tol >= 0):
+            raise ParameterError(f"reduce_mu_tol must be >= 0, got {self.reduce_mu_tol!r}")
         if not (np.isfinite(self.dscale_overrelax) and 1.0 <= self.dscale_overrelax <= 4.0):
             raise ParameterError("dscale_overrelax must be in [1, 4], got "
                                  f"{self.dscale_overrelax!r}")
@@ -374,6 +381,9 @@ class MusynResult:
         Why the loop stopped.
     reduced_from : int or None
         Order before a successful order reduction, else ``None``.
+    K_full, mu_peak_full : control.StateSpace or None, float or None
+        After an order reduction: the full-order controller and its µ peak on the
+        dense grid (``mu_peak`` is the reduced one's).
     seconds : float
         Total wall time.
     omega : numpy.ndarray
@@ -393,6 +403,8 @@ class MusynResult:
     best_iteration: int
     stop_reason: str
     reduced_from: int | None = None
+    K_full: control.StateSpace | None = None
+    mu_peak_full: float | None = None
     seconds: float = 0.0
     omega: np.ndarray = field(default_factory=lambda: np.zeros(0))
     certificates: tuple = ()
@@ -629,7 +641,8 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
                                                    first=best is None)
         if failure is not None:
             stop_reason = f"K-step failed at iteration {it}: {failure}"
-            logger.warning("musyn: %s; keeping the best so far", stop_reason)
+            # a stop, told in ``stop_reason``; the best iterate is certified as ever
+            logger.info("musyn: %s; keeping the best so far", stop_reason)
             break
         K = syn.K
         t1 = time.perf_counter()
@@ -682,7 +695,7 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
             except LmiSuspensionError as exc:
                 # no usable scaled plant for the next K-step: end with the best iterate
                 done = f"D-fit failed after iteration {it}: {exc}"
-                logger.warning("musyn: %s; keeping iteration %d", done, best[2])
+                logger.info("musyn: %s; keeping iteration %d", done, best[2])
         t4 = time.perf_counter()
         record = MusynIteration(
             index=it, gamma=float(syn.gamma), mu_peak=mu_peak,
@@ -755,21 +768,11 @@ def _certified(setup, best, history, stop_reason: str, t_start: float) -> MusynR
     CL = balanced_statespace(mu_part(CL_full, struct))
     dense = _dense_grid(omega, int(opts.n_dense), history[best_it - 1].peak_omega, CL)
     final = _final_bounds(CL, struct, dense, rng)
-    reduced_from = None
-    if opts.reduce_order is not None and int(opts.reduce_order) < K.nstates:
-        K_red = _try_reduce(K, int(opts.reduce_order))
-        if K_red is not None:
-            CL_red_full = lft(G, K_red)
-            CL_red = balanced_statespace(mu_part(CL_red_full, struct))
-            if np.all(np.real(CL_red.poles()) < 0) and all(
-                    c.met for c in certificates(constraints, CL_red_full)):
-                final_red = _final_bounds(CL_red, struct, dense, rng)
-                if np.max(final_red.upper) <= np.max(final.upper) * (1 + opts.reduce_mu_tol):
-                    reduced_from = K.nstates
-                    K, CL, CL_full, final = K_red, CL_red, CL_red_full, final_red
-                else:
-                    logger.info("musyn: reduced controller rejected (µ %.4f vs %.4f)",
-                                np.max(final_red.upper), np.max(final.upper))
+    reduced_from, K_full, mu_full = None, None, None
+    reduced = _reduction(setup, K, final, dense, rng)
+    if reduced is not None:
+        reduced_from, K_full, mu_full = K.nstates, K, float(np.max(final.upper))
+        K, CL, CL_full, final = reduced
     upper = np.asarray(final.upper)
     k_peak = int(np.argmax(upper))
     checks: tuple = ()
@@ -794,6 +797,7 @@ def _certified(setup, best, history, stop_reason: str, t_start: float) -> MusynR
         peak_omega=float(dense[k_peak]), mu_bound=float(mu_bound), mu=final,
         history=tuple(history),
         best_iteration=best_it, stop_reason=stop_reason, reduced_from=reduced_from,
+        K_full=K_full, mu_peak_full=mu_full,
         seconds=time.perf_counter() - t_start, omega=omega,
         certificates=certificates(constraints, CL_full), warnings=checks)
 
@@ -866,7 +870,7 @@ def _done(setup, it: int, mu_peak: float, gamma: float, gamma_prev: float,
         done = (f"the K-step at iteration {it} is worse on the scaled plant than the "
                 f"previous controller (gamma {gamma:.4f} > {gamma_prev:.4f}): it has lost "
                 "accuracy on this scaled plant")
-        logger.warning("musyn: %s", done)
+        logger.info("musyn: %s", done)
         return done
     if since_best >= opts.patience:
         return f"no improvement of {opts.min_improvement:.1%} in {opts.patience} iterations"
@@ -913,8 +917,8 @@ def _previous_level(nxt, setup) -> float:
 def _with_uncertainty(P, blk, nmeas: int, ncon: int):
     """``(P, blk)`` of a certain plant as given; of an uncertain one, its ``lftdata``
     with the full performance block appended."""
-    from ..uncertain.lfr import _Uncertain
-    from ..uncertain.uss import lftdata
+    from ..umodel.lfr import _Uncertain
+    from ..umodel.uss import lftdata
 
     if not isinstance(P, _Uncertain):
         if blk is None:
@@ -995,6 +999,49 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
                   f"{found.gamma:.6g}",)
         + _bound_check(found.gamma, lower_peak, "D-scale search"),
         gamma_prev=found.level_start, K=found.K, stage="dscale_search")
+
+
+def _reduction(setup, K, final, dense, rng):
+    """The returned controller's order reduction (``reduce_order``): ``(K, CL, CL_full,
+    final)`` of the balanced truncation kept, or None.  A truncation is kept where its
+    loop is stable, meets the constraints, and its µ peak on the dense grid is within
+    ``reduce_mu_tol`` of the full order's.  With ``"auto"`` the least such order is
+    found by bisection between 1 and the full order (µ of a balanced truncation falls
+    nearly monotonically with its order; each order tried costs one dense-grid µ)."""
+    opts = setup.options
+    if opts.reduce_order is None:
+        return None
+    limit = float(np.max(final.upper)) * (1.0 + opts.reduce_mu_tol)
+    tried = {}
+
+    def attempt(order: int):
+        K_red = _try_reduce(K, order)
+        if K_red is None:
+            return None
+        CL_red_full = lft(setup.G, K_red)
+        CL_red = balanced_statespace(mu_part(CL_red_full, setup.struct))
+        if not (np.all(np.real(CL_red.poles()) < 0) and all(
+                c.met for c in certificates(setup.constraints, CL_red_full))):
+            logger.info("musyn: order %d: unstable loop or a constraint missed", order)
+            return None
+        final_red = _final_bounds(CL_red, setup.struct, dense, rng)
+        peak = float(np.max(final_red.upper))
+        logger.info("musyn: order %d: µ %.4f (full order %d: %.4f)", order, peak,
+                    K.nstates, float(np.max(final.upper)))
+        return (K_red, CL_red, CL_red_full, final_red) if peak <= limit else None
+
+    if opts.reduce_order != "auto":
+        order = int(opts.reduce_order)
+        return attempt(order) if order < K.nstates else None
+    lo, hi = 1, K.nstates  # the full order is acceptable; the least acceptable is sought
+    while lo < hi:
+        mid = (lo + hi) // 2
+        tried[mid] = attempt(mid)
+        if tried[mid] is not None:
+            hi = mid
+        else:
+            lo = mid + 1
+    return tried.get(hi)
 
 
 def _try_reduce(K: control.StateSpace, order: int):

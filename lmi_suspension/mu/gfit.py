@@ -42,13 +42,14 @@ mixed-µ bounds of its true closed loop, not by the scalings.
 from __future__ import annotations
 
 import logging
+import warnings
 from dataclasses import dataclass
 
 import control
 import numpy as np
 
 from ..errors import DimensionError, SolverError
-from .blocks import BlockStructure
+from ..umodel.blocks import BlockStructure
 
 logger = logging.getLogger(__name__)
 
@@ -179,7 +180,7 @@ def central_dg(M, struct: BlockStructure, beta: float, g_max: float = 5.0):
             Q[i].value = Mk.conj().T @ EL[i] @ Mk
         for i in real:
             R[i].value = 1j * (S[i] @ Mk - Mk.conj().T @ S[i].T)
-        prob.solve(solver=cp.CLARABEL)
+        _solve(prob, f"central D-G scalings at frequency index {k}")
         if prob.status not in ("optimal", "optimal_inaccurate") or x.value is None:
             raise SolverError(f"central D-G scalings: solver status {prob.status} at "
                               f"frequency index {k}")
@@ -188,6 +189,20 @@ def central_dg(M, struct: BlockStructure, beta: float, g_max: float = 5.0):
         g[:, k] = [float(gv.value[i]) / (xv[i] * beta) for i in real]
         margin[k] = float(t.value)
     return d, g, margin
+
+
+def _solve(prob, what: str) -> None:
+    """Solve with Clarabel.  An inaccurate solution is used as it is: scalings only
+    choose the plant of the next K-step, and the µ bound of the loop it leads to is
+    computed afresh, so CVXPY's warning is replaced by an INFO record."""
+    import cvxpy as cp
+
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Solution may be inaccurate",
+                                category=UserWarning)
+        prob.solve(solver=cp.CLARABEL)
+    if prob.status == "optimal_inaccurate":
+        logger.info("%s: the solver's solution is inaccurate; used as it is", what)
 
 
 def _selector(rs: slice, cs: slice, nin: int, nout: int) -> np.ndarray:
@@ -485,7 +500,7 @@ def _optimal_gscales(omega, Mt, struct, poles, g_max) -> GScaleFit:
     # |ĝ| = |z|/β <= g_max at the grid points, with β <= beta0 (the unscaled level)
     cons.append(cp.abs(a @ Bn.T) <= g_max * beta0)
     prob = cp.Problem(cp.Minimize(lam), cons)
-    prob.solve(solver=cp.CLARABEL)
+    _solve(prob, "optimal G-scalings")
     if prob.status not in ("optimal", "optimal_inaccurate") or a.value is None:
         raise SolverError(f"optimal G-scalings: solver status {prob.status}")
     beta = float(np.sqrt(max(lam.value, 1e-300)))

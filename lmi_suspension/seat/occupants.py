@@ -449,7 +449,7 @@ class MixedMuCheck:
 def _lower_bound_seat(aug, rs) -> tuple[SeatParameters | None, float]:
     """``(seat, ω)`` of the robust-stability lower bound's perturbation (see
     :attr:`MixedMuCheck.rs_worst`)."""
-    from ..mu.blocks import BlockStructure
+    from ..umodel.blocks import BlockStructure
     from .uncertainty import parametric_uncertainty
 
     lower = np.asarray(rs.lower, dtype=float).ravel()
@@ -598,7 +598,7 @@ class MixedRsBound:
     """
 
     def __init__(self, occupants: OccupantSet | None = None, design=None, omega=None):
-        from ..mu.blocks import BlockStructure
+        from ..umodel.blocks import BlockStructure
         from .augmented import seat_augmented_plant
 
         occupants = OccupantSet() if occupants is None else occupants

@@ -217,7 +217,7 @@ class TwoBlockMu:
 
     def __post_init__(self):
         from ..lti import freqresp
-        from ..mu.blocks import BlockStructure
+        from ..umodel.blocks import BlockStructure
 
         aug = seat_augmented_plant(self.design, self.params)
         blk = np.asarray(aug.blk)

@@ -25,7 +25,7 @@ import control
 import numpy as np
 
 from ...lti.plant import GeneralizedPlant
-from ..blocks import BlockStructure
+from ...umodel.blocks import BlockStructure
 
 __all__ = ["DKSetup", "DKSteps", "KStep", "KStepResult", "ScaleStep", "ScaleFit",
            "LoopAnalysis", "NextPlant"]

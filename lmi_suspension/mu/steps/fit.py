@@ -19,7 +19,7 @@ import numpy as np
 
 from ...lti.norms import freqresp, hinfnorm
 from ...lti.plant import lft
-from ..blocks import BlockStructure
+from ...umodel.blocks import BlockStructure
 from . import DKSetup, LoopAnalysis, NextPlant, ScaleFit, block_sizes, mu_part
 
 logger = logging.getLogger(__name__)

@@ -23,7 +23,7 @@ from ...errors import (DimensionError, InfeasibleError, LmiSuspensionError, Para
                        SolverError)
 from ...lti.norms import hinfnorm
 from ...lti.plant import GeneralizedPlant, lft
-from ..blocks import BlockStructure
+from ...umodel.blocks import BlockStructure
 from . import DKSetup, KStep, certificates, mu_part
 
 logger = logging.getLogger(__name__)

@@ -1,6 +1,6 @@
 """Uncertain state-space systems: building, interconnecting, substituting, sampling.
 
-:func:`uss` builds a :class:`~lmi_suspension.uncertain.lfr.USS` from (uncertain)
+:func:`uss` builds a :class:`~lmi_suspension.umodel.lfr.USS` from (uncertain)
 matrices; :func:`feedback` and :func:`connect` interconnect; :func:`lftdata` returns
 the certain part ``M`` and the normalised block structure; :func:`usubs`,
 :func:`usample` and :func:`nominal` return python-control ``StateSpace`` objects.
@@ -16,9 +16,9 @@ import control
 import numpy as np
 
 from ..errors import DimensionError, InputError, NonFiniteError, ParameterError
-from ..mu.blocks import BlockStructure
-from .atoms import UComplex, UReal, ULTIDyn
-from .lfr import USS, UBlock, UMat, _Uncertain, _build, as_uncertain, interconnect_parts
+from .atoms import UComplex, UReal
+from .blocks import BlockStructure
+from .lfr import USS, UBlock, UMat, _build, _Uncertain, as_uncertain, interconnect_parts
 
 __all__ = ["LFTData", "uss", "feedback", "connect", "lftdata", "usubs", "usample", "nominal"]
 
@@ -42,7 +42,7 @@ def uss(A, B=None, C=None, D=None, *, inputs=None, outputs=None) -> USS:
     -------
     USS
         With the minimal repetition of each parameter this reduction finds (see
-        :func:`~lmi_suspension.uncertain.lfr.reduce_lfr`).
+        :func:`~lmi_suspension.umodel.lfr.reduce_lfr`).
 
     Raises
     ------

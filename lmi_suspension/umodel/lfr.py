@@ -39,7 +39,6 @@ import scipy.linalg
 
 from ..errors import DimensionError, IllPosedLoopError, InputError, NonFiniteError, ParameterError
 from ..lti.checks import as_statespace
-from .atoms import UComplex, UReal, ULTIDyn, _Arith
 
 __all__ = ["UBlock", "UMat", "USS", "as_uncertain", "interconnect_parts", "reduce_lfr", "umat"]
 
@@ -47,6 +46,54 @@ logger = logging.getLogger(__name__)
 
 #: relative rank tolerance of the structured Kalman reduction (see _reach)
 _REDUCE_RTOL = 1e-10
+
+
+class _Atom:
+    """Base of the uncertain elements of :mod:`.atoms`: their arithmetic is that of their
+    LFR.  The LFR asks of an atom only its ``kind`` -- ``"real"`` (``nominal`` and
+    ``lfr_coefficients``), ``"complex"`` (``nominal``, ``radius``) or ``"dynamic"``
+    (``ny``, ``nu``, ``bound``) -- so this module does not know the atoms' classes."""
+
+    kind = ""
+    __array_ufunc__ = None  # numpy defers to our reflected operators
+
+    def _lfr(self):
+        return as_uncertain(self)
+
+    def __add__(self, other):
+        return self._lfr() + other
+
+    def __radd__(self, other):
+        return self._lfr().__radd__(other)
+
+    def __sub__(self, other):
+        return self._lfr() - other
+
+    def __rsub__(self, other):
+        return self._lfr().__rsub__(other)
+
+    def __mul__(self, other):
+        return self._lfr() * other
+
+    def __rmul__(self, other):
+        return self._lfr().__rmul__(other)
+
+    def __truediv__(self, other):
+        return self._lfr() / other
+
+    def __rtruediv__(self, other):
+        return self._lfr().__rtruediv__(other)
+
+    def __neg__(self):
+        return -self._lfr()
+
+    def __pos__(self):
+        return self._lfr()
+
+
+def _scalar(atom) -> bool:
+    """True for an atom whose block is ``δ I`` (real, complex, or a SISO ``ultidyn``)."""
+    return atom.kind != "dynamic" or (atom.ny == 1 and atom.nu == 1)
 
 
 @dataclass(frozen=True)
@@ -64,16 +111,15 @@ class UBlock:
     @property
     def reducible(self) -> bool:
         """True for repeated scalar blocks (``δ I_r`` commutes with any ``r × r`` basis)."""
-        a = self.atom
-        return isinstance(a, (UReal, UComplex)) or (isinstance(a, ULTIDyn) and a.ny == 1 and a.nu == 1)
+        return _scalar(self.atom)
 
     @property
     def blk_row(self) -> list[int]:
         """MATLAB ``mussv`` row of this block."""
         a = self.atom
-        if isinstance(a, UReal):
+        if a.kind == "real":
             return [-self.nw, 0]
-        if isinstance(a, UComplex) or (isinstance(a, ULTIDyn) and self.nw > 1 and a.ny == 1 and a.nu == 1):
+        if a.kind == "complex" or (self.nw > 1 and _scalar(a)):
             return [self.nw, 0]
         return [self.nw, self.nz]
 
@@ -279,11 +325,11 @@ def _copy(x: _Uncertain) -> _Uncertain:
 
 # ---------------------------------------------------------------------------- conversion
 def _atom_lfr(atom) -> _Uncertain:
-    if isinstance(atom, UReal):
+    if atom.kind == "real":
         a, c = atom.lfr_coefficients
         return UMat(np.zeros((0, 0)), np.zeros((0, 2)), np.zeros((2, 0)),
                     np.array([[a, 1.0], [c, atom.nominal]]), [UBlock(atom, 1, 1)])
-    if isinstance(atom, UComplex):
+    if atom.kind == "complex":
         return UMat(np.zeros((0, 0)), np.zeros((0, 2)), np.zeros((2, 0)),
                     np.array([[0.0, 1.0], [atom.radius, atom.nominal]]), [UBlock(atom, 1, 1)])
     ny, nu = atom.ny, atom.nu
@@ -302,7 +348,7 @@ def as_uncertain(x) -> _Uncertain:
     """
     if isinstance(x, _Uncertain):
         return x
-    if isinstance(x, _Arith):
+    if isinstance(x, _Atom):
         return _atom_lfr(x)
     if isinstance(x, (control.StateSpace, control.TransferFunction)):
         ss = as_statespace(x, "system")
@@ -477,7 +523,7 @@ def _merge(x: _Uncertain) -> _Uncertain:
     pw, pz, blocks = [], [], []
     for name, idx in order.items():
         atom = atoms[name]
-        if len(idx) > 1 and isinstance(atom, ULTIDyn) and (atom.ny, atom.nu) != (1, 1):
+        if len(idx) > 1 and not _scalar(atom):
             raise ParameterError(
                 f"the ultidyn {name!r} ({atom.ny}x{atom.nu}) enters the model {len(idx)} times; "
                 "a repeated multivariable dynamic uncertainty is not supported")

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DimensionError, NonFiniteError, ParameterError
+from .lfr import _Atom
 
 __all__ = ["UReal", "UComplex", "ULTIDyn", "ureal", "ucomplex", "ultidyn"]
 
@@ -51,48 +52,8 @@ def _real(value, what: str, name: str) -> float:
     return value
 
 
-class _Arith:
-    """Arithmetic of atoms: they behave as 1×1 (or ny×nu) uncertain matrices/systems."""
-
-    __array_ufunc__ = None  # numpy defers to our reflected operators
-
-    def _lfr(self):
-        from .lfr import as_uncertain
-        return as_uncertain(self)
-
-    def __add__(self, other):
-        return self._lfr() + other
-
-    def __radd__(self, other):
-        return self._lfr().__radd__(other)
-
-    def __sub__(self, other):
-        return self._lfr() - other
-
-    def __rsub__(self, other):
-        return self._lfr().__rsub__(other)
-
-    def __mul__(self, other):
-        return self._lfr() * other
-
-    def __rmul__(self, other):
-        return self._lfr().__rmul__(other)
-
-    def __truediv__(self, other):
-        return self._lfr() / other
-
-    def __rtruediv__(self, other):
-        return self._lfr().__rtruediv__(other)
-
-    def __neg__(self):
-        return -self._lfr()
-
-    def __pos__(self):
-        return self._lfr()
-
-
 @dataclass(frozen=True, eq=True)
-class UReal(_Arith):
+class UReal(_Atom):
     """Uncertain real parameter (build it with :func:`ureal`).
 
     Attributes
@@ -102,6 +63,7 @@ class UReal(_Arith):
         Nominal value and range (``lo < nominal < hi``, or the symmetric case).
     """
 
+    kind = "real"  # not a field: what the LFR asks of an atom (see lfr._Atom)
     name: str
     nominal: float
     lo: float
@@ -143,9 +105,10 @@ class UReal(_Arith):
 
 
 @dataclass(frozen=True, eq=True)
-class UComplex(_Arith):
+class UComplex(_Atom):
     """Uncertain complex parameter ``nominal + radius δ``, ``|δ| <= 1`` (see :func:`ucomplex`)."""
 
+    kind = "complex"
     name: str
     nominal: float
     radius: float
@@ -164,9 +127,10 @@ class UComplex(_Arith):
 
 
 @dataclass(frozen=True, eq=True)
-class ULTIDyn(_Arith):
+class ULTIDyn(_Atom):
     """Uncertain stable LTI dynamics, ``ny × nu``, ``‖Δ‖∞ <= bound`` (see :func:`ultidyn`)."""
 
+    kind = "dynamic"
     name: str
     ny: int
     nu: int
@@ -178,7 +142,7 @@ def ureal(name: str, nominal: float, *, range=None, percent=None, plusminus=None
 
     Give exactly one of ``range``, ``percent`` and ``plusminus``.  The normalised
     ``δ ∈ [-1, 1]`` is affine in the value for ranges symmetric about the nominal and
-    linear fractional otherwise (see :mod:`lmi_suspension.uncertain.atoms`).
+    linear fractional otherwise (see :mod:`lmi_suspension.umodel.atoms`).
 
     Parameters
     ----------
