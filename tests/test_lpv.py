@@ -17,7 +17,7 @@ import pytest
 from lmi_suspension.errors import (DimensionError, DiscreteTimeError, LmiSuspensionError,
                                    NonFiniteError, ParameterError)
 from lmi_suspension.lpv import LpvsynResult, ScheduledController, lpvsyn
-from lmi_suspension.lti import lft
+from lmi_suspension.lti import hinfnorm, lft
 from lmi_suspension.synthesis import hinfsyn
 
 GRID = {"m": np.linspace(1.0, 4.0, 9)}
@@ -582,6 +582,46 @@ def test_hinfgs_certified_for_any_rate_and_equal_to_the_gridded_lmi():
     # and is a controller of the plant at any k: stable frozen loops
     for k in (0.5, 1.7, 4.0):
         assert np.max(np.linalg.eigvals(lft(_stiff(k), res.K.at(k=k)).A).real) < 0.0
+
+
+def test_hinfgs_json_round_trip_is_exact(tmp_path):
+    """Issue 61 item 3 for the polytopic controller: saved and loaded, the vertex
+    controllers are the same IEEE-754 numbers, so ``at(p)`` is equal bit for bit at any
+    ``p`` (it is computed from them and ``p`` alone), and the certified γ travels in the
+    metadata."""
+    import json
+
+    from lmi_suspension.errors import InputError
+    from lmi_suspension.io import (
+        load_scheduled_controller,
+        save_scheduled_controller,
+        scheduled_from_dict,
+        scheduled_to_dict,
+    )
+    from lmi_suspension.lpv import PolytopicController, hinfgs
+
+    res = hinfgs(_stiff, {"k": (0.5, 4.0)}, 1, 1)
+    path = save_scheduled_controller(tmp_path / "K.json", res)
+    K, meta = load_scheduled_controller(path)
+    assert isinstance(K, PolytopicController)
+    assert json.loads(path.read_text())["format"] == "lmi_suspension.polytopic_controller/1"
+    assert (K.names, K.bounds, K.vertices, K.level) == \
+        (res.K.names, res.K.bounds, res.K.vertices, res.K.level)
+    assert all(_same_ss(a, b) for a, b in zip(K.controllers, res.K.controllers))
+    for k in (0.5, 1.2345678901234567, np.pi, 4.0):       # vertices and between them
+        assert _same_ss(K.at(k=k), res.K.at(k=k))
+    assert meta == {"gamma": res.gamma, "gamma_lmi": res.gamma_lmi}
+    # the loaded controller's certificate is the saved one (the same loops, recomputed)
+    k0 = float(res.check_grid["k"][1])
+    assert float(hinfnorm(lft(_stiff(k0), K.at(k=k0)))[0]) == res.gamma_check[1]
+    data = scheduled_to_dict(res.K)
+    with pytest.raises(InputError, match="tables"):
+        scheduled_to_dict(res.K, table={"k": [1.0]})
+    del data["controllers"]
+    with pytest.raises(InputError, match="controllers"):
+        scheduled_from_dict(data)
+    with pytest.raises(InputError, match="format"):
+        scheduled_from_dict({"format": "something else"})
 
 
 @pytest.mark.parametrize("P, bounds, err, text", [
