@@ -279,12 +279,18 @@ def _json_default(obj):
 
 # ----------------------------------------------------------------- scheduled controllers
 SCHEDULED_FORMAT = "lmi_suspension.scheduled_controller/1"
+#: :func:`~lmi_suspension.lpv.hinfgs`'s controller: the box and the vertex controllers
+POLYTOPIC_FORMAT = "lmi_suspension.polytopic_controller/1"
 
 
 def scheduled_to_dict(K, *, table=None, frozen: bool = True, metadata=None) -> dict:
     """Describe a :class:`~lmi_suspension.lpv.ScheduledController` (or the
     :class:`~lmi_suspension.lpv.LpvsynResult` holding it: its ``gamma`` and
-    ``gamma_lmi`` then go into the metadata) as a JSON-ready dict.
+    ``gamma_lmi`` then go into the metadata) as a JSON-ready dict; or a
+    :class:`~lmi_suspension.lpv.PolytopicController` of ``hinfgs`` (or its
+    ``HinfgsResult``), format ``lmi_suspension.polytopic_controller/1``: the box, the
+    vertices, the level and each vertex controller's ``A``, ``B``, ``C``, ``D``
+    (``table`` and ``frozen`` do not apply: the vertex controllers are the data).
 
     The description holds everything :meth:`ScheduledController.at` needs (the
     Lyapunov coefficients ``X_i``, ``Y_i``, the scalings, the plant and basis as tables:
@@ -305,10 +311,18 @@ def scheduled_to_dict(K, *, table=None, frozen: bool = True, metadata=None) -> d
     >>> bool(np.array_equal(K2.at(m=2.5).A, K.at(m=2.5).A))       # a table node
     True
     """
+    from .synthesis.hinfgs import PolytopicController
+
     metadata = dict(metadata or {})
-    if hasattr(K, "K") and hasattr(K, "gamma_check"):        # an LpvsynResult
+    if hasattr(K, "K") and hasattr(K, "gamma_check"):        # an LpvsynResult, HinfgsResult
         metadata = {"gamma": float(K.gamma), "gamma_lmi": float(K.gamma_lmi), **metadata}
         K = K.K
+    if isinstance(K, PolytopicController):
+        if table is not None:
+            raise InputError("a polytopic controller has no tables: it is saved exactly "
+                             "by its vertex controllers")
+        # the vertex controllers are the saved data: no separate frozen entries
+        return {"format": POLYTOPIC_FORMAT, **K.to_dict(), "metadata": metadata}
     data = {"format": SCHEDULED_FORMAT, **K.to_dict(table)}
     if frozen:
         entries = []
@@ -324,13 +338,18 @@ def scheduled_to_dict(K, *, table=None, frozen: bool = True, metadata=None) -> d
 
 
 def scheduled_from_dict(data: dict):
-    """The :class:`~lmi_suspension.lpv.ScheduledController` of
-    :func:`scheduled_to_dict` (exactly)."""
+    """The :class:`~lmi_suspension.lpv.ScheduledController` (or
+    :class:`~lmi_suspension.lpv.PolytopicController`) of :func:`scheduled_to_dict`
+    (exactly)."""
+    from .synthesis.hinfgs import PolytopicController
     from .synthesis.lpv import ScheduledController
 
-    if not isinstance(data, dict) or data.get("format") != SCHEDULED_FORMAT:
+    fmt = data.get("format") if isinstance(data, dict) else None
+    if fmt == POLYTOPIC_FORMAT:
+        return PolytopicController.from_dict(data)
+    if fmt != SCHEDULED_FORMAT:
         raise InputError(f"not a scheduled controller description (format "
-                         f"{SCHEDULED_FORMAT!r})")
+                         f"{SCHEDULED_FORMAT!r} or {POLYTOPIC_FORMAT!r})")
     return ScheduledController.from_dict(data)
 
 
@@ -346,7 +365,9 @@ def save_scheduled_controller(path, K, *, table=None, frozen: bool = True,
 def load_scheduled_controller(path):
     """Read a file of :func:`save_scheduled_controller`: ``(K, metadata)``, ``K`` a
     :class:`~lmi_suspension.lpv.ScheduledController` equal to the saved one (its
-    ``at`` bit for bit at every table node)."""
+    ``at`` bit for bit at every table node), or a
+    :class:`~lmi_suspension.lpv.PolytopicController` (its ``at`` bit for bit
+    everywhere)."""
     data = _read(path)
     return scheduled_from_dict(data), dict(data.get("metadata", {}))
 

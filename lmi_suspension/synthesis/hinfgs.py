@@ -33,14 +33,14 @@ from dataclasses import dataclass
 import control
 import numpy as np
 
-from ..errors import AssumptionError, DimensionError, ParameterError
+from ..errors import AssumptionError, DimensionError, InputError, ParameterError
 from ..lti.checks import finite_scalar
 from ..lti.norms import hinfnorm
 from ..lti.plant import lft
 from ..lti.scaling import PlantScaling, scale_plant
 from . import lmi as _lmi
 from .hinfsyn import _undo_loop_shift, _without_d22
-from .lpv import _apply_scaling, _axes, _check_axes, _gamma_lmi, _plant_at
+from .lpv import _apply_scaling, _axes, _check_axes, _floats, _gamma_lmi, _plant_at
 from .result import HinfsynOptions
 
 __all__ = ["HinfgsResult", "PolytopicController", "hinfgs"]
@@ -99,6 +99,48 @@ class PolytopicController:
         mats = [sum(ai * np.asarray(getattr(K, M), dtype=float)
                     for ai, K in zip(a, self.controllers)) for M in "ABCD"]
         return control.ss(*mats)
+
+    def to_dict(self) -> dict:
+        """JSON-ready description: the box, the vertices and each vertex controller's
+        matrices, every float a Python float (which :mod:`json` writes as its shortest
+        round-tripping repr), so that :meth:`from_dict` gives back the same IEEE-754
+        numbers and ``at(p)`` of the loaded controller equals the original's bit for bit
+        at every ``p``, not only at the vertices (it is computed from those numbers
+        alone)."""
+        return {
+            "names": list(self.names),
+            "bounds": [[float(lo), float(hi)] for lo, hi in self.bounds],
+            "vertices": [[float(v) for v in vert] for vert in self.vertices],
+            "level": float(self.level),
+            "controllers": [{"shape": [int(K.nstates), int(K.ninputs), int(K.noutputs)],
+                             **{M: _floats(getattr(K, M)) for M in "ABCD"}}
+                            for K in self.controllers],
+        }
+
+    @classmethod
+    def from_dict(cls, data: dict) -> PolytopicController:
+        """The controller described by :meth:`to_dict` (exactly)."""
+        try:
+            names = tuple(str(n) for n in data["names"])
+            bounds = tuple((float(lo), float(hi)) for lo, hi in data["bounds"])
+            vertices = tuple(tuple(float(v) for v in vert) for vert in data["vertices"])
+            if len(bounds) != len(names) or any(len(v) != len(names) for v in vertices):
+                raise DimensionError("the bounds and vertices do not match the "
+                                     f"{len(names)} parameters {names}")
+            if len(data["controllers"]) != len(vertices):
+                raise DimensionError(f"{len(data['controllers'])} vertex controllers for "
+                                     f"{len(vertices)} vertices")
+            controllers = []
+            for K in data["controllers"]:
+                n, ny, nu = (int(v) for v in K["shape"])
+                mats = [np.asarray(K[M], dtype=float).reshape(shape) for M, shape in
+                        zip("ABCD", ((n, n), (n, ny), (nu, n), (nu, ny)))]
+                controllers.append(control.ss(*mats))
+            return cls(names, bounds, vertices, tuple(controllers), float(data["level"]))
+        except KeyError as exc:
+            raise InputError(f"polytopic controller description lacks key {exc}") from exc
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"malformed polytopic controller description: {exc}") from exc
 
 
 @dataclass(frozen=True)
