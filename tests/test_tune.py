@@ -906,3 +906,42 @@ def test_systune_from_an_infeasible_start_reaches_the_constrained_optimum():
     assert res.values["K.k"] == pytest.approx(-5.0, rel=1e-5)
     assert res.soft == pytest.approx(np.sqrt(7.25) / 6, rel=1e-5)
     assert np.linalg.eigvals(res.CL[0].A).real.max() <= -6.0
+
+
+# --------------------------------------------------------------------------- a given start
+@pytest.mark.parametrize("order", [1, 2, 3, 5])
+def test_a_state_space_start_is_the_given_controller(order):
+    """``tunable_ss(..., start=K)`` realizes ``K`` in the block's modal form: the same
+    frequency response (an independent evaluation of both by control.evalfr), with
+    complex pairs and real poles in either parity."""
+    rng = np.random.default_rng(order)
+    for _ in range(5):
+        A = rng.standard_normal((order, order)) - 2.0 * np.eye(order)
+        K0 = control.ss(A, rng.standard_normal((order, 3)), rng.standard_normal((2, order)),
+                        rng.standard_normal((2, 3)))
+        K = tunable_ss("K", order, 2, 3, start=K0)
+        for w in (0.0, 0.3, 2.0, 7.0):
+            np.testing.assert_allclose(control.evalfr(K.ss(K.start), 1j * w),
+                                       control.evalfr(K0, 1j * w), rtol=1e-8, atol=1e-10)
+
+
+def test_a_state_space_start_of_the_wrong_kind_is_a_typed_error():
+    with pytest.raises(DimensionError):
+        tunable_ss("K", 2, 1, 1, start=control.ss(control.tf([1.0], [1.0, 1.0])))
+    with pytest.raises(ParameterError):                       # a double pole at -1
+        tunable_ss("K", 2, 1, 1, start=control.ss([[-1.0, 1.0], [0.0, -1.0]], [[0.0], [1.0]],
+                                                  [[1.0, 0.0]], [[0.0]]))
+
+
+def test_tuning_from_a_given_controller_never_ends_above_it():
+    """Started from hinfsyn's controller on plant d (3 states; a user's start, as MATLAB's
+    hinfstruct starts from a block's current value), the search only descends: the tuned
+    γ is at most the start's certified γ, and at least the full-order optimum."""
+    P = plant_d()
+    syn = hinfsyn(P, 1, 1)
+    K = tunable_ss("K", 3, 1, 1, start=syn.K)
+    g0 = hinfnorm(lft(P, K.ss(K.start)))[0]
+    assert g0 == pytest.approx(syn.gamma, rel=1e-6)
+    res = hinfstruct(P, K, options=HinfstructOptions(max_iter=20))
+    assert res.gamma <= g0 and res.gamma >= res.gamma_opt * (1 - 1e-5)
+    assert res.gap < 1e-3
