@@ -35,8 +35,15 @@ from IPython.display import Markdown, display
 
 from lmi_suspension import hinfnorm, lft
 from lmi_suspension.examples import compleib
-from lmi_suspension.tune import (HinfBound, Margins, SystuneOptions, hinfstruct, systune,
-                                 tunable_pid, tunable_ss)
+from lmi_suspension.tune import (
+    HinfBound,
+    Margins,
+    SystuneOptions,
+    hinfstruct,
+    systune,
+    tunable_pid,
+    tunable_ss,
+)
 
 warnings.simplefilter("ignore", FutureWarning)      # python-control's augw uses connect()
 s = control.tf("s")
