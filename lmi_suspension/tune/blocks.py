@@ -405,6 +405,54 @@ def _ss_labels(order, ny, nu):
     return labels, kinds
 
 
+#: two eigenvalues closer than this (relative to the largest magnitude, floor 1) are
+#: taken as a repeated one, whose modal realization is ill-conditioned or does not exist
+_MODAL_SEPARATION = 1e-8
+
+
+def _modal_parameters(K, order, ny, nu, kinds):
+    """The full parameter vector of a ``tunable_ss`` block realizing the continuous-time
+    controller ``K``: a modal realization (``scipy.linalg.cdf2rdf`` form), complex pairs
+    first, then the real poles paired into ``[[λ1, 0], [0, λ2]]`` blocks, an odd one
+    last -- the pattern of ``kinds`` (the parity of the real poles is that of the order,
+    so the pattern always fits)."""
+    if not isinstance(K, control.StateSpace) or not K.isctime():
+        raise ParameterError("a start controller must be a continuous-time StateSpace")
+    A, B, C, D = (np.atleast_2d(np.asarray(M, dtype=float)) for M in (K.A, K.B, K.C, K.D))
+    if (K.noutputs, K.ninputs) != (ny, nu) or K.nstates != order:
+        raise DimensionError(f"the start controller has {K.noutputs} outputs, {K.ninputs} "
+                             f"inputs and {K.nstates} states; the block {ny}, {nu} and {order}")
+    if not all(np.all(np.isfinite(M)) for M in (A, B, C, D)):
+        raise NonFiniteError("the start controller holds NaN or infinity")
+    if order == 0:
+        return D.ravel()
+    lam, V = np.linalg.eig(A)
+    scale = max(1.0, float(np.max(np.abs(lam))))
+    gaps = np.abs(lam[:, None] - lam[None, :])
+    np.fill_diagonal(gaps, np.inf)
+    if np.min(gaps) < _MODAL_SEPARATION * scale or np.linalg.cond(V) > 1e12:
+        raise ParameterError("the start controller has a repeated pole: a tunable_ss block "
+                             "(2 x 2 modal blocks) realizes distinct poles only")
+    cplx = [k for k in range(order) if lam[k].imag > 0]
+    real = [k for k in range(order) if lam[k].imag == 0 or
+            abs(lam[k].imag) <= _MODAL_SEPARATION * scale]
+    cols, a_part = [], []
+    for k in cplx:                           # A [Re v, Im v] = [Re v, Im v] [[σ, ω], [-ω, σ]]
+        v = V[:, k] / np.linalg.norm(V[:, k])        # one scale for the pair keeps that form
+        cols += [v.real, v.imag]
+        a_part += [lam[k].real, lam[k].imag, lam[k].real]
+    real = sorted(real, key=lambda k: lam[k].real)
+    for j in range(0, len(real) - 1, 2):
+        cols += [V[:, real[j]].real, V[:, real[j + 1]].real]
+        a_part += [lam[real[j]].real, 0.0, lam[real[j + 1]].real]
+    if len(real) % 2:
+        cols.append(V[:, real[-1]].real)
+        a_part.append(lam[real[-1]].real)
+    T = np.column_stack(cols)
+    Bm, Cm = np.linalg.solve(T, B), C @ T
+    return np.concatenate([a_part, Bm.ravel(), Cm.ravel(), D.ravel()])
+
+
 class _StateSpace(_Block):
     kind = "tunable state space"
 
@@ -422,6 +470,8 @@ class _StateSpace(_Block):
             i += k
         default = np.concatenate([np.array(a_part), np.ones(order * nu),
                                   np.zeros(ny * order + ny * nu)])
+        if isinstance(start, control.StateSpace):
+            start = dict(zip(labels, _modal_parameters(start, order, ny, nu, self._kinds)))
         super().__init__(name, ny, nu, order, labels, default, start=start, fixed=fixed)
 
     def _full_matrices(self, p):
@@ -510,10 +560,14 @@ def tunable_ss(name: str, order: int, ny: int, nu: int, *, start=None, fixed=Non
         Number of states (0 gives a static gain ``D``).
     ny, nu : int
         Numbers of outputs (controls) and inputs (measurements), MATLAB's order.
-    start, fixed : mapping of str to float, optional
-        Starting values and parameters held at a value, by short (``"D[0,0]"``) or full
-        name.  The default start is ``A = -diag(1, 2, ..., order)``, ``B = 1``,
-        ``C = 0``, ``D = 0`` (the block starts at ``K = 0``, its modes distinct).
+    start : mapping of str to float, or control.StateSpace, optional
+        Starting values by short (``"D[0,0]"``) or full name; or a controller of this
+        order (as MATLAB's ``hinfstruct`` starts from a block's current value), realized
+        in the block's modal form (its poles must be distinct).  The default start is
+        ``A = -diag(1, 2, ..., order)``, ``B = 1``, ``C = 0``, ``D = 0`` (the block starts
+        at ``K = 0``, its modes distinct).
+    fixed : mapping of str to float, optional
+        Parameters held at a value, by short or full name.
 
     Returns
     -------
@@ -522,9 +576,10 @@ def tunable_ss(name: str, order: int, ny: int, nu: int, *, start=None, fixed=Non
     Raises
     ------
     DimensionError
-        A negative order or a size below 1.
+        A negative order or a size below 1; a start controller of another size.
     ParameterError, NonFiniteError
-        An unknown parameter name, a non-finite value, or every parameter fixed.
+        An unknown parameter name, a non-finite value, every parameter fixed, or a start
+        controller with a repeated pole.
 
     Examples
     --------
@@ -535,6 +590,14 @@ def tunable_ss(name: str, order: int, ny: int, nu: int, *, start=None, fixed=Non
     >>> theta[:3] = [-1.0, 2.0, -1.0]                     # the pair -1 ± 2j
     >>> sorted(K.ss(theta).poles().round(6).tolist(), key=lambda p: p.imag)
     [(-1-2j), (-3+0j), (-1+2j)]
+
+    Started from a given controller (the same transfer function, another realization):
+
+    >>> import control
+    >>> K0 = control.ss(control.tf([1.0, 3.0], [1.0, 2.0, 5.0]))
+    >>> K = tunable_ss("K", 2, 1, 1, start=K0)
+    >>> bool(np.allclose(control.evalfr(K.ss(K.start), 2j), control.evalfr(K0, 2j)))
+    True
     """
     return _StateSpace(name, order, ny, nu, start=start, fixed=fixed)
 

@@ -1,0 +1,159 @@
+"""Acceptance figures of structured H∞ tuning (issue 60), as markdown tables.
+
+Run (from the repository root, about 15 minutes on one core of a 2-core Zen 1 EPYC)::
+
+    MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1 PYTHONPATH=. python benchmarks/tune_table.py
+
+1. PI and PID (filter fixed at 0.05 s) on three plants of tests/test_tune.py (mixed
+   sensitivity: a first-order plant, a lightly damped second order, a Padé delay), each
+   tuned by ``hinfstruct`` (2 starts, ``default_rng(0)``) beside a brute-force grid over
+   the parameters refined around its best points (``_grid_min`` of tests/test_tune.py:
+   every point one ``hinfnorm``), then polished by SciPy's Nelder-Mead (derivative-free,
+   another route than the tuner's) from the grid's best point; the final grid spacing
+   is printed.
+2. Five COMPleib plants shipped with the package: a full-order ``tunable_ss`` against
+   ``hinfsyn``'s certified optimum (``gamma_lower``, a lower bound for every controller),
+   with the default budget (2 starts of 200 iterations) and a longer one (2 starts of
+   1000); and static output feedback (``tunable_gain``, 4 starts) beside a reference: a
+   brute-force grid where the gain has at most two entries, else 16 starts from another
+   seed.  No published HIFOO / hinfstruct figure for these plants was found in the
+   sources this project could search (see the issue note), so the reference is our own.
+"""
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import control
+import numpy as np
+import scipy.optimize
+
+warnings.simplefilter("ignore")
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
+
+from test_tune import _grid_min, pi_ss, pid_ss, plant_a, plant_b, plant_d
+
+from lmi_suspension import hinfnorm, lft
+from lmi_suspension.examples import compleib
+from lmi_suspension.tune import (
+    HinfstructOptions,
+    hinfstruct,
+    tunable_gain,
+    tunable_pid,
+    tunable_ss,
+)
+
+TF = 0.05
+PLANTS = {"a (2 states)": plant_a, "b (4 states)": plant_b, "d (3 states)": plant_d}
+PI_BOX = {"a (2 states)": [(0.0, 5.0), (0.0, 5.0)],
+          "b (4 states)": [(-0.5, 1.0), (0.0, 1.5)],
+          "d (3 states)": [(0.0, 2.0), (0.0, 2.0)]}
+PID_BOX = {"a (2 states)": [(0.0, 4.0), (0.0, 4.0), (-0.5, 0.5)],
+           "b (4 states)": [(-0.5, 1.0), (0.0, 1.5), (-0.1, 0.1)],
+           "d (3 states)": [(0.0, 1.6), (0.0, 1.6), (-0.2, 0.2)]}
+COMPLEIB = ("AC4", "HE1", "NN2", "REA1", "REA2")
+
+
+def fmt(x):
+    return ", ".join(f"{v:.3g}" for v in np.atleast_1d(x))
+
+
+def polish(P, make_K, x0):
+    """Nelder-Mead on ``hinfnorm(lft(P, K(x)))`` from ``x0`` (unstable: 1e10)."""
+    def f(x):
+        g = hinfnorm(lft(P, make_K(*x)))[0]
+        return g if np.isfinite(g) else 1e10
+    r = scipy.optimize.minimize(f, np.asarray(x0, float), method="Nelder-Mead",
+                                options={"xatol": 1e-7, "fatol": 1e-10, "maxfev": 3000})
+    return min(float(r.fun), f(x0))
+
+
+def table_pid():
+    print("| loop | plant | tuned γ | s | grid min γ | grid spacing | grid + Nelder-Mead γ | s "
+          "| tuned / reference − 1 |")
+    print("|---|---|---|---|---|---|---|---|---|")
+    for kind in ("PI", "PID"):
+        for name, make in PLANTS.items():
+            P = make()
+            t = time.perf_counter()
+            block = tunable_pid("C", "PI") if kind == "PI" else tunable_pid("C", "PID", tf=TF)
+            res = hinfstruct(P, block, starts=2, rng=np.random.default_rng(0))
+            t_tune = time.perf_counter() - t
+            assert res.gamma == hinfnorm(lft(P, res.K))[0]
+            t = time.perf_counter()
+            if kind == "PI":
+                make = pi_ss
+                grid, x, spacing = _grid_min(P, make, PI_BOX[name], (21, 21))
+            else:
+                def make(kp, ki, kd):
+                    return pid_ss(kp, ki, kd, TF)
+                grid, x, spacing = _grid_min(P, make, PID_BOX[name], (13, 13, 13), nref=5,
+                                             keep=2)
+            ref = polish(P, make, x)
+            t_grid = time.perf_counter() - t
+            print(f"| {kind} | {name} | {res.gamma:.6f} | {t_tune:.1f} | {grid:.6f} | "
+                  f"{fmt(spacing)} | {ref:.6f} | {t_grid:.1f} | "
+                  f"{100 * (res.gamma / ref - 1):+.3f} % |", flush=True)
+
+
+def table_full_order():
+    print("| plant | n | ny, nu | hinfsyn optimum (lower) | tuned γ, 2 × 200 it. | gap | s "
+          "| tuned γ, 2 × 1000 it. | gap | s |")
+    print("|---|---|---|---|---|---|---|---|---|---|")
+    for name in COMPLEIB:
+        P = compleib(name)
+        row = [name, str(P.nstates), f"{P.ny}, {P.nu}"]
+        for k, it in enumerate((200, 1000)):
+            t = time.perf_counter()
+            res = hinfstruct(P, tunable_ss("K", P.nstates, P.nu, P.ny), starts=2,
+                             rng=np.random.default_rng(0),
+                             options=HinfstructOptions(max_iter=it))
+            dt = time.perf_counter() - t
+            if k == 0:
+                row.append(f"{res.gamma_opt:.6g}")
+            row += [f"{res.gamma:.6g}", f"{100 * res.gap:+.3f} %", f"{dt:.0f}"]
+        print("| " + " | ".join(row) + " |", flush=True)
+
+
+def _sof_grid(P, res):
+    """A brute-force grid over a static gain of at most two entries: 41 points an axis
+    over the tuned value ± max(2 |k|, 2), refined 3 times around the 3 best points."""
+    k = res.theta
+    boxes = [(v - max(2 * abs(v), 2.0), v + max(2 * abs(v), 2.0)) for v in k]
+    shape = (P.nu, P.ny)
+
+    def make(*theta):
+        return np.array(theta, dtype=float).reshape(shape)
+
+    ref, _, spacing = _grid_min(P, lambda *t: control.ss([], [], [], make(*t)), boxes,
+                                (41,) * len(k))
+    return ref, f"grid, spacing {fmt(spacing)}"
+
+
+def table_sof():
+    print("| plant | gain | tuned γ (4 starts) | s | reference γ | reference | s "
+          "| tuned / reference − 1 |")
+    print("|---|---|---|---|---|---|---|---|")
+    for name in COMPLEIB:
+        P = compleib(name)
+        t = time.perf_counter()
+        res = hinfstruct(P, tunable_gain("K", P.nu, P.ny), starts=4,
+                         rng=np.random.default_rng(0))
+        dt = time.perf_counter() - t
+        t = time.perf_counter()
+        if res.theta.size <= 2:
+            ref, how = _sof_grid(P, res)
+        else:
+            r2 = hinfstruct(P, tunable_gain("K", P.nu, P.ny), starts=16,
+                            rng=np.random.default_rng(1))
+            ref, how = r2.gamma, "16 starts, default_rng(1)"
+        dr = time.perf_counter() - t
+        print(f"| {name} | {P.nu} × {P.ny} | {res.gamma:.6g} | {dt:.1f} | {ref:.6g} | {how} "
+              f"| {dr:.0f} | {100 * (res.gamma / ref - 1):+.3f} % |", flush=True)
+
+
+if __name__ == "__main__":
+    which = sys.argv[1:] or ["pid", "full", "sof"]
+    for w in which:
+        {"pid": table_pid, "full": table_full_order, "sof": table_sof}[w]()
+        print()
