@@ -212,7 +212,7 @@ def test_musyn_of_a_discrete_plant_refuses_what_the_map_does_not_carry():
         musyn(Pd, 1, 1, [[1, 1], [1, 1]], constraints=[HinfBound(bound=10.0)])
 
 
-@pytest.mark.slow  # 230 s on Zen 1 (2026-12-02): the second tier
+@pytest.mark.slow  # 169 s on Zen 1 under Sandybridge (2026-12-02): the second tier
 def test_mixed_dgk_on_a_discrete_plant():
     # the stiffness oscillator (lmi_suspension.examples, a real stiffness) at 50 ms: D-G-K
     # keeps the stiffness real on the image as on the continuous plant; measured mixed µ
@@ -229,7 +229,7 @@ def test_mixed_dgk_on_a_discrete_plant():
     assert disc.mu_peak < 1.131  # below the complexified design (measured 1.1309)
 
 
-@pytest.mark.slow  # 40 s on Zen 1 (2026-12-02, beside other work): the second tier
+@pytest.mark.slow  # 34-40 s on Zen 1 (2026-12-02): the second tier
 def test_discrete_h2hinfsyn_returns_the_certified_norms():
     # AC4 sampled with a zero-order hold at 50 ms (D22 stays 0): the Pareto point of
     # ‖T∞‖∞² + ‖T2‖₂² (the H2 channel is z's last row), its norms recomputed here on CL

@@ -58,7 +58,7 @@ def test_integer_delay_radii_refuse_what_is_not_a_whole_sample():
     assert P.P.dt == DT and P.P.nstates == sampled_augmented_plant(DT).P.nstates
 
 
-@pytest.mark.slow  # 60 s on Zen 1 (2026-12-02): the second tier
+@pytest.mark.slow  # 31 s on Zen 1 under Sandybridge (2026-12-02): the second tier
 def test_the_seat_designed_at_1_khz():
     from lmi_suspension.lti import freqresp, lft
     from lmi_suspension.mu import mussv
