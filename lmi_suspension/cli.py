@@ -608,12 +608,13 @@ def build_parser() -> argparse.ArgumentParser:
                                "met; the certificate's verdict on issue 38's targets is "
                                "printed)")
     p_de.add_argument("route", choices=("mu", "constrained", "refined", "occupants",
-                                        "peak_bounded"),
+                                        "peak_bounded", "discrete"),
                       help="mu: D-K as in the paper (seconds); constrained: hard force/stroke "
                            "bounds in every K-step (minutes); refined: the µ controller "
                            "refined to the bump requirements (minutes); occupants: that "
                            "refinement over 30-70 kg and aged springs (tens of minutes); "
-                           "peak_bounded: H∞ with peak bounds, no delay (seconds)")
+                           "peak_bounded: H∞ with peak bounds, no delay (seconds); "
+                           "discrete: D-K on the plant sampled at 1 kHz (a minute)")
     p_de.add_argument("--out", required=True, help="controller file to write")
     p_de.add_argument("--seed", type=int, default=0, help="seed of the route's random draws")
     p_de.set_defaults(func=_cmd_design)
