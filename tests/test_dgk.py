@@ -396,3 +396,116 @@ def test_scaled_peak_is_the_norm_of_the_d_scaled_loop():
         DL, DR = np.diag([d1, 1.0]), np.diag([d1, d1, 1.0])
         ref = max(ref, np.linalg.norm(DL @ M[:, :, k] @ np.linalg.inv(DR), 2))
     assert _scaled_peak(fits, M, w, struct) == pytest.approx(ref, rel=1e-12)
+
+
+# the oscillator's D-G-K runs of the tests below: a coarse grid and Riccati K-steps keep
+# them to a few seconds; they test the loop's rules, not the µ reached
+_QUICK = dict(method="riccati", dscale_search=0, n_dense=10)
+_QUICK_W = np.logspace(-2, 1.5, 15)
+
+
+def _coarse_dense_grid(monkeypatch):
+    """The returned loop's µ certified on the design grid itself (the dense grid's 400+
+    mixed-µ LMIs are what makes these runs long; the rule under test is the same)."""
+    from lmi_suspension.mu import dk
+
+    monkeypatch.setattr(dk, "_dense_grid", lambda omega, n, peak, CL: np.asarray(omega))
+
+
+def test_the_complexified_controller_is_kept_where_dgk_certifies_higher(monkeypatch):
+    """Injection: in the D-G-K phase, from iteration 2 on, the K-step returns a worse
+    controller (the central H∞ one at twice the optimal level) and the D/G-step reports
+    half its µ, so the loop takes it for its best.  The dense-grid certificate, computed
+    apart from the steps, finds it above the complexified D-K's controller (D-G-K's
+    start, ``complex_start``), which must then be returned, and the result says so."""
+    from dataclasses import replace
+
+    from lmi_suspension import HinfsynOptions
+    from lmi_suspension.mu.steps import DKSteps
+    from lmi_suspension.mu.steps.dgstep import MussvStep
+    from lmi_suspension.mu.steps.kstep import _GivenController, default_kstep
+
+    _coarse_dense_grid(monkeypatch)
+    P = oscillator()
+    struct = BlockStructure.coerce(BLK)
+    g_opt = hinfsyn(P, 1, 1, method="riccati").gamma
+    poor = hinfsyn(P, 1, 1, method="riccati", options=HinfsynOptions(gamma=2 * g_opt)).K
+
+    class Worse:
+        def __init__(self, setup):
+            self.mixed, self.inner = setup.mixed, default_kstep(setup)
+
+        def __call__(self, PD, *, iteration, gamma_prev):
+            if self.mixed and iteration >= 2:
+                return _GivenController(poor, float(gamma_prev), ("injected",))
+            return self.inner(PD, iteration=iteration, gamma_prev=gamma_prev)
+
+    class Lying(MussvStep):
+        def __call__(self, CL, K):
+            here = super().__call__(CL, K)
+            if self.setup.mixed and K is poor:
+                return replace(here, mu_peak=here.mu_peak / 2, lower_peak=here.mu_peak / 2,
+                               upper=here.upper / 2)
+            return here
+
+    res = musyn(P, 1, 1, BLK, omega=_QUICK_W, steps=DKSteps(kstep=Worse, dgstep=Lying),
+                options=MusynOptions(max_iter=2, **_QUICK))
+    assert [h.K is poor for h in res.history] == [False, True]  # the injection took hold
+    assert res.best_iteration == 1 and res.K is res.complex_start.K
+    assert "complexified D-K's controller is returned" in res.stop_reason
+    # the two routes: the injected iterate's µ recomputed here on the dense grid is above
+    # what the returned controller certifies there (each loop's own LMI-refined bound)
+    dense = res.mu.omega
+    mu_poor = mussv(freqresp(_mu_part(lft(P, poor), struct), dense), struct, omega=dense)
+    assert float(np.max(mu_poor.lower)) > res.mu_peak
+    assert res.complex_start.mu_peak == pytest.approx(res.mu_peak, rel=0, abs=0)
+    # certificates of the returned controller: poles, bounds in order, bound recomputed
+    assert np.all(res.CL.poles().real < 0)
+    assert res.mu_lower_peak <= res.mu_peak
+    again = mussv(freqresp(_mu_part(lft(P, res.K), struct), dense), struct, omega=dense,
+                  method="lmi")
+    assert float(np.max(again.upper)) == pytest.approx(res.mu_peak, rel=2e-3)  # LMI tol
+
+
+def test_a_time_budget_ends_both_phases_after_their_first_iterate_and_says_so(monkeypatch):
+    """A budget far below one iteration: the complexified phase and D-G-K each stop
+    after their first iterate (the unit the budget counts in), the result is that
+    iterate's certified controller, and ``stop_reason`` names the budget."""
+    _coarse_dense_grid(monkeypatch)
+    P = oscillator()
+    res = musyn(P, 1, 1, BLK, omega=_QUICK_W,
+                options=MusynOptions(max_iter=6, time_budget=1e-3, **_QUICK))
+    assert len(res.history) == 1 and len(res.complex_start.history) == 1
+    assert "time budget of 0.001 s" in res.stop_reason
+    assert "time budget of 0.001 s" in res.complex_start.stop_reason
+    assert np.all(res.CL.poles().real < 0) and res.mu_lower_peak <= res.mu_peak
+    with pytest.raises(ParameterError):
+        MusynOptions(time_budget=0.0)
+    with pytest.raises(ParameterError):
+        MusynOptions(max_gfit_poles=0)
+
+
+def test_max_gfit_poles_caps_the_states_the_g_scalings_add(loop, monkeypatch):
+    """With a level target no basis reaches, ``optimal_gscales`` tries every basis size
+    of ``_G_POLE_COUNTS``; ``max_poles`` stops it at the largest size within the cap (or
+    the cap itself below the smallest), and the scaled plant then has at most three
+    states per pole and real block more than the D-scaled one (gfit's docstring)."""
+    from lmi_suspension.mu import gfit
+
+    P, K, struct, w, M = loop
+    tried = []
+    inner = gfit._optimal_gscales
+
+    def recorded(omega, Mt, struct, poles, g_max):
+        tried.append(len(poles))
+        return inner(omega, Mt, struct, poles, g_max)
+
+    monkeypatch.setattr(gfit, "_optimal_gscales", recorded)
+    optimal_gscales(w, M, struct, target=1e-3)
+    assert tried == list(gfit._G_POLE_COUNTS)
+    for cap, sizes in ((4, [3]), (2, [2])):
+        tried.clear()
+        capped = optimal_gscales(w, M, struct, target=1e-3, max_poles=cap)
+        assert tried == sizes and capped.poles[0].size == sizes[-1]
+        PG = gscaled_plant(P, 1, 1, struct, capped)
+        assert PG.nstates <= P.nstates + 3 * sizes[-1]

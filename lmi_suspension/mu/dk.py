@@ -258,6 +258,9 @@ class MusynOptions:
     dscale_overrelax: float = 2.0
     dscale_search: int = 200
     complexify: bool = False
+    complex_start: bool = True
+    max_gfit_poles: int = 10
+    time_budget: float | None = None
 
     def __post_init__(self):
         if int(self.max_iter) < 1 or int(self.patience) < 1:
@@ -280,6 +283,13 @@ class MusynOptions:
                                  f"{self.dscale_overrelax!r}")
         if int(self.dscale_search) < 0:
             raise ParameterError(f"dscale_search must be >= 0, got {self.dscale_search!r}")
+        if int(self.max_gfit_poles) < 1:
+            raise ParameterError(f"max_gfit_poles must be >= 1, got {self.max_gfit_poles!r}")
+        if self.time_budget is not None and not (
+                isinstance(self.time_budget, (int, float)) and not isinstance(
+                    self.time_budget, bool) and self.time_budget > 0):
+            raise ParameterError(f"time_budget must be None or a positive number of "
+                                 f"seconds, got {self.time_budget!r}")
 
 
 @dataclass(frozen=True)
@@ -410,9 +420,38 @@ class MusynResult:
     certificates: tuple = ()
     warnings: tuple = ()
     mu_bound: float = float("nan")
+    complex_start: _ComplexStart | None = field(default=None, repr=False)
 
     def __iter__(self):
         return iter((self.K, self.CL, self.mu_peak, self))
+
+
+@dataclass(frozen=True)
+class _ComplexStart:
+    """The complexified D-K run that D-G-K starts from (``MusynOptions.complex_start``).
+
+    Attributes
+    ----------
+    K : control.StateSpace
+        Its best controller (lowest complex µ on the design grid): D-G-K's first iterate,
+        and a candidate for the returned controller.
+    history : tuple of MusynIteration
+        Its iterations (complex µ) and D-scale search.
+    stop_reason : str
+        Why it stopped.
+    seconds : float
+        Its wall time.
+    mu_peak : float or None
+        Its controller's mixed µ peak on the dense grid, where the final comparison
+        computed it (None where D-G-K's result was already no higher than that
+        controller's µ lower bound, so no comparison was needed).
+    """
+
+    K: control.StateSpace
+    history: tuple
+    stop_reason: str
+    seconds: float
+    mu_peak: float | None = None
 
 
 def default_omega(P, n: int = 60) -> np.ndarray:
@@ -604,10 +643,7 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         size is not ``ncon x nmeas``, ``DiscreteTimeError`` if it is discrete).
     """
     from ..synthesis.hinfsyn import _hinfsyn as hinfsyn  # the D-scale search's
-    from .steps import NextPlant
-    from .steps.dgstep import MussvStep
-    from .steps.fit import default_fit
-    from .steps.kstep import GivenFirst, default_kstep
+    from .steps.kstep import _GivenController
 
     G_d = _discrete_plant(P, nmeas, ncon)
     if G_d is not None:
@@ -619,10 +655,39 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
     t_start = time.perf_counter()
     setup, given = _setup(P, nmeas, ncon, blk, omega, options, rng, constraints,
                           lyapunov_scales, K0)
+    steps = steps if steps is not None else DKSteps()
+    rival = None
+    if setup.mixed and setup.options.complex_start:
+        # the complex D is a feasible mixed scaling with G = 0: the complexified run's
+        # controller is a candidate D-G-K must beat, and D-G-K starts from it
+        cx_setup = replace(setup, mixed=False, dk_struct=_complexified(setup.struct),
+                           options=replace(setup.options, complexify=True))
+        cx_best, cx_history, cx_stop = _dk_loop(cx_setup, steps, given, None, hinfsyn,
+                                                t_start)
+        rival = _ComplexStart(K=cx_best[1], history=tuple(cx_history), stop_reason=cx_stop,
+                              seconds=time.perf_counter() - t_start)
+        logger.info("musyn: complexified D-K ended at complex µ %.4f in %.1f s (%s); D-G-K "
+                    "from its controller", cx_best[0], rival.seconds, cx_stop)
+        given = _GivenController(rival.K, float(hinfnorm(mu_part(lft(setup.G, rival.K),
+                                                                  setup.struct))[0]),
+                                 ("the complexified D-K's controller: no K-step",))
+    best, history, stop_reason = _dk_loop(setup, steps, given, callback, hinfsyn, t_start)
+    return _certified(setup, best, history, stop_reason, t_start, rival=rival)
+
+
+def _dk_loop(setup, steps: DKSteps, given, callback, hinfsyn, t_start: float):
+    """The D-K (or D-G-K) iterations and the D-scale search of one run:
+    ``(best, history, stop_reason)``, ``best = (mu_peak, K, index)`` on the design grid
+    (``setup.dk_struct``'s µ), nothing certified on the dense grid yet."""
+    from .steps import NextPlant
+    from .steps.dgstep import MussvStep
+    from .steps.fit import default_fit
+    from .steps.kstep import GivenFirst, default_kstep
+
     opts, rng, omega, struct, constraints, mixed, G = (
         setup.options, setup.rng, setup.omega, setup.struct, setup.constraints,
         setup.mixed, setup.G)
-    steps = steps if steps is not None else DKSteps()
+    nmeas, ncon = setup.nmeas, setup.ncon
     kstep = (steps.kstep or default_kstep)(setup)
     if given is not None:
         kstep = GivenFirst(given, kstep)
@@ -634,6 +699,7 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
     searched = None  # the D-scale search's record, from iteration 1's D-step
     stop_reason = f"reached max_iter={opts.max_iter}"
     since_best = 0
+    t_last = None  # start of the previous iteration (the time budget's estimate)
     nxt = NextPlant(PD=G.sys, orders=(), K_ref=None)  # the plant of the next K-step
     for it in range(1, int(opts.max_iter) + 1):
         t0 = time.perf_counter()
@@ -676,11 +742,14 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         excused = getattr(fitstep, "restarts_from_best", False) and best[2] != it
         done = _done(setup, it, mu_peak, float(syn.gamma), gamma_prev, since_best,
                      excused=excused)
+        over = _over_budget(opts, t_start, t0 if t_last is None else t_last, it, best[2])
+        t_last = t0
+        done = done if done is not None or over is None else over
 
         # the D-scale search starts from this D-step, so it runs now, and the D-K
         # iterations after it measure their progress against it; its own copy of the
         # generator leaves them as they are without it
-        if it == 1 and _search_applies(setup, best):
+        if it == 1 and over is None and _search_applies(setup, best):
             searched = _search_stage(G, nmeas, ncon, setup.dk_struct, omega,
                                      (here.d_blocks, here.upper), opts, copy.deepcopy(rng),
                                      index=0, hinfsyn=hinfsyn)
@@ -724,7 +793,7 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         if _search_wins(searched, history[best[2] - 1], setup):
             best = (searched.mu_peak, searched.K, len(history))
             stop_reason += f"; D-scale search to µ {searched.mu_peak:.4f}"
-    return _certified(setup, best, history, stop_reason, t_start)
+    return best, history, stop_reason
 
 
 def _search_wins(searched: MusynIteration, dk_best: MusynIteration, setup) -> bool:
@@ -756,7 +825,8 @@ def _search_applies(setup, best) -> bool:
     return True
 
 
-def _certified(setup, best, history, stop_reason: str, t_start: float) -> MusynResult:
+def _certified(setup, best, history, stop_reason: str, t_start: float,
+               rival: _ComplexStart | None = None) -> MusynResult:
     """The best iterate's result: its µ on a dense grid with the true structure (the
     peak refined with the LMI bound, bounded between grid points), its controller
     reduced where asked and µ allows, its constraints recomputed."""
@@ -768,6 +838,10 @@ def _certified(setup, best, history, stop_reason: str, t_start: float) -> MusynR
     CL = balanced_statespace(mu_part(CL_full, struct))
     dense = _dense_grid(omega, int(opts.n_dense), history[best_it - 1].peak_omega, CL)
     final = _final_bounds(CL, struct, dense, rng)
+    if rival is not None:
+        (K, CL_full, CL, dense, final, best_it, stop_reason,
+         rival) = _against_complex(setup, rival, history, (K, CL_full, CL, dense, final),
+                                   best_it, stop_reason)
     reduced_from, K_full, mu_full = None, None, None
     reduced = _reduction(setup, K, final, dense, rng)
     if reduced is not None:
@@ -799,7 +873,49 @@ def _certified(setup, best, history, stop_reason: str, t_start: float) -> MusynR
         best_iteration=best_it, stop_reason=stop_reason, reduced_from=reduced_from,
         K_full=K_full, mu_peak_full=mu_full,
         seconds=time.perf_counter() - t_start, omega=omega,
-        certificates=certificates(constraints, CL_full), warnings=checks)
+        certificates=certificates(constraints, CL_full), warnings=checks,
+        complex_start=rival)
+
+
+def _against_complex(setup, rival: _ComplexStart, history, mine, best_it: int,
+                     stop_reason: str):
+    """D-G-K's best controller against the complexified D-K's (``complex_start``), both
+    certified with mixed µ: the lower is returned, and ``stop_reason`` says which.
+    ``mine`` is ``(K, CL_full, CL, dense, final)`` of D-G-K's best; returns those of the
+    chosen controller, its iteration, the reason and ``rival`` with its µ where computed.
+
+    D-G-K's first iterate is the complexified run's controller, so where it is the best
+    there is nothing to compare; where D-G-K's certified peak is no higher than that
+    iterate's µ lower bound on the design grid, it cannot be higher than the other's
+    certified µ either, and the other's dense-grid certificate (the costly part) is
+    skipped."""
+    K, CL_full, CL, dense, final = mine
+    peak = float(np.max(final.upper))
+    first = history[0]
+    if best_it == 1:
+        why = ("; the complexified D-K's controller is returned (D-G-K's first iterate: "
+               f"mixed µ {peak:.4f}; no D-G-K iterate beat it)")
+        return K, CL_full, CL, dense, final, 1, stop_reason + why, replace(rival,
+                                                                            mu_peak=peak)
+    if peak <= first.mu_lower_peak:
+        why = (f"; D-G-K's controller (mixed µ {peak:.4f}) is returned: the complexified "
+               f"D-K's has mixed µ at least {first.mu_lower_peak:.4f}")
+        return K, CL_full, CL, dense, final, best_it, stop_reason + why, rival
+    G, struct = setup.G, setup.struct
+    CLr_full = lft(G, rival.K)
+    CLr = balanced_statespace(mu_part(CLr_full, struct))
+    dense_r = _dense_grid(setup.omega, int(setup.options.n_dense), first.peak_omega, CLr)
+    final_r = _final_bounds(CLr, struct, dense_r, setup.rng)
+    peak_r = float(np.max(final_r.upper))
+    rival = replace(rival, mu_peak=peak_r)
+    if peak_r < peak:
+        why = (f"; the complexified D-K's controller is returned (mixed µ {peak_r:.4f}): "
+               f"D-G-K's best iterate {best_it} certified {peak:.4f} on the dense grid")
+        logger.info("musyn: %s", why[2:])
+        return rival.K, CLr_full, CLr, dense_r, final_r, 1, stop_reason + why, rival
+    why = (f"; D-G-K's controller (mixed µ {peak:.4f}) is returned: the complexified "
+           f"D-K's certified {peak_r:.4f}")
+    return K, CL_full, CL, dense, final, best_it, stop_reason + why, rival
 
 
 
@@ -877,6 +993,22 @@ def _done(setup, it: int, mu_peak: float, gamma: float, gamma_prev: float,
     if it == opts.max_iter:
         return f"reached max_iter={opts.max_iter}"
     return None
+
+
+def _over_budget(opts, t_start: float, t_prev: float, it: int, best_it: int) -> str | None:
+    """Why the run stops for its ``time_budget`` after iteration ``it``, or None: where
+    the time spent plus one more iteration as long as the last one (``t_prev`` its start)
+    would pass the budget.  The iterations are the unit: a K-step is not interrupted."""
+    if opts.time_budget is None:
+        return None
+    now = time.perf_counter()
+    spent = now - t_start
+    if spent + (now - t_prev) <= opts.time_budget:
+        return None
+    done = (f"time budget of {opts.time_budget:g} s: {spent:.1f} s spent after iteration "
+            f"{it}, another would not fit; the best iterate ({best_it}) is returned")
+    logger.info("musyn: %s", done)
+    return done
 
 
 def _k_step_on(kstep, nxt, it: int, setup, *, first: bool):

@@ -142,7 +142,7 @@ def _dg_scaled(G, nmeas, ncon, struct, free, M, beta, omega, weights, opts, K_re
                       weights=weights)
     PD = _scaled(G, nmeas, ncon, fit, struct, free)
     Mt = freqresp(mu_part(lft(PD, K_ref, nmeas, ncon), struct), omega)
-    gfit = optimal_gscales(omega, Mt, struct, target=beta)
+    gfit = optimal_gscales(omega, Mt, struct, target=beta, max_poles=opts.max_gfit_poles)
     logger.info("musyn: D-G scalings at level %.5g for the loop at %.5g", gfit.beta, beta)
     return fit, gscaled_plant(PD, nmeas, ncon, struct, gfit)
 
