@@ -400,7 +400,7 @@ def test_scaled_peak_is_the_norm_of_the_d_scaled_loop():
 
 # the oscillator's D-G-K runs of the tests below: a coarse grid and Riccati K-steps keep
 # them to a few seconds; they test the loop's rules, not the µ reached
-_QUICK = dict(method="riccati", dscale_search=0, n_dense=10)
+_QUICK = {"method": "riccati", "dscale_search": 0, "n_dense": 10}
 _QUICK_W = np.logspace(-2, 1.5, 15)
 
 
@@ -416,8 +416,9 @@ def test_the_complexified_controller_is_kept_where_dgk_certifies_higher(monkeypa
     """Injection: in the D-G-K phase, from iteration 2 on, the K-step returns a worse
     controller (the central H∞ one at twice the optimal level) and the D/G-step reports
     half its µ, so the loop takes it for its best.  The dense-grid certificate, computed
-    apart from the steps, finds it above the complexified D-K's controller (D-G-K's
-    start, ``complex_start``), which must then be returned, and the result says so."""
+    apart from the steps, finds it above the complexified D-K's controller (the
+    default ``complex_candidate="keep"``), which must then be returned, and the result
+    says so."""
     from dataclasses import replace
 
     from lmi_suspension import HinfsynOptions
@@ -451,14 +452,14 @@ def test_the_complexified_controller_is_kept_where_dgk_certifies_higher(monkeypa
     res = musyn(P, 1, 1, BLK, omega=_QUICK_W, steps=DKSteps(kstep=Worse, dgstep=Lying),
                 options=MusynOptions(max_iter=2, **_QUICK))
     assert [h.K is poor for h in res.history] == [False, True]  # the injection took hold
-    assert res.best_iteration == 1 and res.K is res.complex_start.K
+    assert res.best_iteration == 0 and res.K is res.complex_run.K
     assert "complexified D-K's controller is returned" in res.stop_reason
     # the two routes: the injected iterate's µ recomputed here on the dense grid is above
     # what the returned controller certifies there (each loop's own LMI-refined bound)
     dense = res.mu.omega
     mu_poor = mussv(freqresp(_mu_part(lft(P, poor), struct), dense), struct, omega=dense)
     assert float(np.max(mu_poor.lower)) > res.mu_peak
-    assert res.complex_start.mu_peak == pytest.approx(res.mu_peak, rel=0, abs=0)
+    assert res.complex_run.mu_peak == pytest.approx(res.mu_peak, rel=0, abs=0)
     # certificates of the returned controller: poles, bounds in order, bound recomputed
     assert np.all(res.CL.poles().real < 0)
     assert res.mu_lower_peak <= res.mu_peak
@@ -475,9 +476,9 @@ def test_a_time_budget_ends_both_phases_after_their_first_iterate_and_says_so(mo
     P = oscillator()
     res = musyn(P, 1, 1, BLK, omega=_QUICK_W,
                 options=MusynOptions(max_iter=6, time_budget=1e-3, **_QUICK))
-    assert len(res.history) == 1 and len(res.complex_start.history) == 1
+    assert len(res.history) == 1 and len(res.complex_run.history) == 1
     assert "time budget of 0.001 s" in res.stop_reason
-    assert "time budget of 0.001 s" in res.complex_start.stop_reason
+    assert "time budget of 0.001 s" in res.complex_run.stop_reason
     assert np.all(res.CL.poles().real < 0) and res.mu_lower_peak <= res.mu_peak
     with pytest.raises(ParameterError):
         MusynOptions(time_budget=0.0)
@@ -492,7 +493,7 @@ def test_max_gfit_poles_caps_the_states_the_g_scalings_add(loop, monkeypatch):
     states per pole and real block more than the D-scaled one (gfit's docstring)."""
     from lmi_suspension.mu import gfit
 
-    P, K, struct, w, M = loop
+    P, _, struct, w, M = loop
     tried = []
     inner = gfit._optimal_gscales
 

@@ -241,6 +241,45 @@ class MusynOptions:
         ``tests/test_dgk.py`` (±50 % real stiffness, 40-point grid, no D-scale search;
         2026-11-27): complex D-K ends at mixed µ 1.1326, D-G-K at 1.0069 (iteration 5;
         ``benchmarks/bench_dgk.py``, figures in ``docs/guide/dk.md``).
+    complex_candidate : {"keep", "start"} or None
+        D-G-K only (real blocks kept real): first run the complexified D-K
+        (``complexify=True``, the same options; its D-scale search included, its
+        dense-grid certificate not), then D-G-K, and return whichever controller
+        certifies the lower mixed µ on the dense grid (the complexified one's mixed µ is
+        first taken on the design grid, and on the dense grid only where D-G-K's
+        certified peak is above its lower bound there).  The complex D is a feasible
+        mixed scaling with G = 0, so the returned mixed µ is no higher than the
+        complexified run's controller certifies.  ``"keep"``: D-G-K starts as without
+        it (from the central controller, or ``K0``); ``"start"``: D-G-K starts from the
+        complexified run's controller (its first iterate, as ``K0``).  From the central
+        controller D-G-K went further on both problems measured (2026-12-02): the
+        oscillator of ``tests/test_dgk.py``, 1.0391 from the complex controller (its
+        third K-step failed) against 1.0069; the two-mass plant of ``tests/test_dgk.py``,
+        1.7778 (the second K-step failed) against 1.6117.  ``stop_reason`` says which
+        controller is returned (``best_iteration`` 0: the complexified run's) and
+        :attr:`MusynResult.complex_run` holds that run.  ``None``: D-G-K alone, which
+        can end above complex D-K (the seat over m3 and k1: 2.734 against 2.671,
+        2026-11-27; the two-mass plant with 10 G poles: 2.7340 against 2.6355, its
+        second K-step failing, 2026-12-02).  With ``K0``, the complexified run starts
+        from it.
+    max_gfit_poles : int or None
+        D-G-K: the largest basis of the G-scalings (poles per real block; each adds
+        three states to the scaled plant per real channel, so this bounds the order of
+        the plant every K-step sees, as MATLAB's ``FitOrder`` does).  None: as many as
+        keep those states within 30 (10 poles for one real channel, 3 for two; the
+        basis sizes tried are 3, 6 and 10).  On the two-mass plant of
+        ``tests/test_dgk.py`` with 10 poles (60 states) the second K-step's LMI grew
+        past 4 GB; with 3 (a 38-state scaled plant) it took 13-16 s and the run
+        811 MB (2026-12-02).
+    time_budget : float or None
+        Seconds of wall time for the iterations (the complexified run of
+        ``complex_candidate`` included): after an iterate, where the time spent plus one
+        more iteration as long as the last would pass it, the run stops and returns the
+        best iterate so far, certified as ever, and ``stop_reason`` says so.  The unit
+        is the iteration (a K-step is not interrupted, at least one iterate is made),
+        the D-scale search is skipped where the budget ends the run at the first
+        iterate, and the dense-grid certificate of the returned controller comes after
+        the budget (on the two-mass plant, 45 s of mixed-µ LMIs).
     """
 
     max_iter: int = 8
@@ -258,8 +297,8 @@ class MusynOptions:
     dscale_overrelax: float = 2.0
     dscale_search: int = 200
     complexify: bool = False
-    complex_start: bool = True
-    max_gfit_poles: int = 10
+    complex_candidate: str | None = "keep"
+    max_gfit_poles: int | None = None
     time_budget: float | None = None
 
     def __post_init__(self):
@@ -283,7 +322,7 @@ class MusynOptions:
                                  f"{self.dscale_overrelax!r}")
         if int(self.dscale_search) < 0:
             raise ParameterError(f"dscale_search must be >= 0, got {self.dscale_search!r}")
-        if int(self.max_gfit_poles) < 1:
+        if self.max_gfit_poles is not None and int(self.max_gfit_poles) < 1:
             raise ParameterError(f"max_gfit_poles must be >= 1, got {self.max_gfit_poles!r}")
         if self.time_budget is not None and not (
                 isinstance(self.time_budget, (int, float)) and not isinstance(
@@ -386,7 +425,8 @@ class MusynResult:
         on the dense grid above the γ certified for that controller on its scaled
         plant: one of the two certificates is then wrong).
     best_iteration : int
-        Index of the iteration whose controller is returned.
+        Index of the iteration whose controller is returned; 0 where it is the
+        complexified run's (``MusynOptions.complex_candidate``, ``complex_run.K``).
     stop_reason : str
         Why the loop stopped.
     reduced_from : int or None
@@ -401,6 +441,10 @@ class MusynResult:
     certificates : tuple of SpecificationCertificate
         With ``constraints``: each constraint recomputed on ``F_l(P, K)`` for the
         returned controller (every one met).
+    complex_run : object or None
+        D-G-K with ``MusynOptions.complex_candidate``: the complexified D-K run whose
+        controller was a candidate (``K``, ``history``, ``stop_reason``, ``seconds``, and
+        ``mu_peak``, its mixed µ on the dense grid where the choice needed it).
     """
 
     K: control.StateSpace
@@ -420,21 +464,22 @@ class MusynResult:
     certificates: tuple = ()
     warnings: tuple = ()
     mu_bound: float = float("nan")
-    complex_start: _ComplexStart | None = field(default=None, repr=False)
+    complex_run: _ComplexRun | None = field(default=None, repr=False)
 
     def __iter__(self):
         return iter((self.K, self.CL, self.mu_peak, self))
 
 
 @dataclass(frozen=True)
-class _ComplexStart:
-    """The complexified D-K run that D-G-K starts from (``MusynOptions.complex_start``).
+class _ComplexRun:
+    """The complexified D-K run whose controller D-G-K must beat
+    (``MusynOptions.complex_candidate``).
 
     Attributes
     ----------
     K : control.StateSpace
-        Its best controller (lowest complex µ on the design grid): D-G-K's first iterate,
-        and a candidate for the returned controller.
+        Its best controller (lowest complex µ on the design grid): a candidate for the
+        returned controller (and D-G-K's first iterate with ``"start"``).
     history : tuple of MusynIteration
         Its iterations (complex µ) and D-scale search.
     stop_reason : str
@@ -444,7 +489,7 @@ class _ComplexStart:
     mu_peak : float or None
         Its controller's mixed µ peak on the dense grid, where the final comparison
         computed it (None where D-G-K's result was already no higher than that
-        controller's µ lower bound, so no comparison was needed).
+        controller's mixed µ lower bound on the design grid).
     """
 
     K: control.StateSpace
@@ -657,17 +702,19 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
                           lyapunov_scales, K0)
     steps = steps if steps is not None else DKSteps()
     rival = None
-    if setup.mixed and setup.options.complex_start:
+    mode = setup.options.complex_candidate
+    if setup.mixed and mode is not None:
         # the complex D is a feasible mixed scaling with G = 0: the complexified run's
-        # controller is a candidate D-G-K must beat, and D-G-K starts from it
+        # controller is a candidate D-G-K must beat ("start": D-G-K starts from it)
         cx_setup = replace(setup, mixed=False, dk_struct=_complexified(setup.struct),
                            options=replace(setup.options, complexify=True))
         cx_best, cx_history, cx_stop = _dk_loop(cx_setup, steps, given, None, hinfsyn,
                                                 t_start)
-        rival = _ComplexStart(K=cx_best[1], history=tuple(cx_history), stop_reason=cx_stop,
+        rival = _ComplexRun(K=cx_best[1], history=tuple(cx_history), stop_reason=cx_stop,
                               seconds=time.perf_counter() - t_start)
-        logger.info("musyn: complexified D-K ended at complex µ %.4f in %.1f s (%s); D-G-K "
-                    "from its controller", cx_best[0], rival.seconds, cx_stop)
+        logger.info("musyn: complexified D-K ended at complex µ %.4f in %.1f s (%s)",
+                    cx_best[0], rival.seconds, cx_stop)
+    if rival is not None and mode == "start":
         given = _GivenController(rival.K, float(hinfnorm(mu_part(lft(setup.G, rival.K),
                                                                   setup.struct))[0]),
                                  ("the complexified D-K's controller: no K-step",))
@@ -826,7 +873,7 @@ def _search_applies(setup, best) -> bool:
 
 
 def _certified(setup, best, history, stop_reason: str, t_start: float,
-               rival: _ComplexStart | None = None) -> MusynResult:
+               rival: _ComplexRun | None = None) -> MusynResult:
     """The best iterate's result: its µ on a dense grid with the true structure (the
     peak refined with the LMI bound, bounded between grid points), its controller
     reduced where asked and µ allows, its constraints recomputed."""
@@ -852,7 +899,7 @@ def _certified(setup, best, history, stop_reason: str, t_start: float,
     checks: tuple = ()
     mu_bound = float("inf")
     # (a D-G-K iterate's γ is the norm of a G-scaled plant, not a bound of µ)
-    if reduced_from is None and not (mixed and best_it > 1):
+    if reduced_from is None and not (mixed and best_it != 1):
         # the dense grid reaches below the design grid, where a certificate computed on
         # the scaled plant can fail: the returned loop's µ is the witness.  Its record
         # was reported already, so the finding goes to the result, not into the record.
@@ -874,25 +921,35 @@ def _certified(setup, best, history, stop_reason: str, t_start: float,
         K_full=K_full, mu_peak_full=mu_full,
         seconds=time.perf_counter() - t_start, omega=omega,
         certificates=certificates(constraints, CL_full), warnings=checks,
-        complex_start=rival)
+        complex_run=rival)
 
 
-def _against_complex(setup, rival: _ComplexStart, history, mine, best_it: int,
+def _against_complex(setup, rival: _ComplexRun, history, mine, best_it: int,
                      stop_reason: str):
-    """D-G-K's best controller against the complexified D-K's (``complex_start``), both
+    """D-G-K's best controller against the complexified D-K's (``complex_candidate``), both
     certified with mixed µ: the lower is returned, and ``stop_reason`` says which.
     ``mine`` is ``(K, CL_full, CL, dense, final)`` of D-G-K's best; returns those of the
     chosen controller, its iteration, the reason and ``rival`` with its µ where computed.
 
-    D-G-K's first iterate is the complexified run's controller, so where it is the best
-    there is nothing to compare; where D-G-K's certified peak is no higher than that
-    iterate's µ lower bound on the design grid, it cannot be higher than the other's
-    certified µ either, and the other's dense-grid certificate (the costly part) is
-    skipped."""
+    With ``"start"``, D-G-K's first iterate is the complexified run's controller, so
+    where it is the best there is nothing to compare.  Where D-G-K's certified peak is
+    no higher than that controller's mixed µ lower bound on the design grid, it cannot
+    be higher than the other's certified µ either, and the other's dense-grid
+    certificate (the costly part) is skipped."""
     K, CL_full, CL, dense, final = mine
     peak = float(np.max(final.upper))
-    first = history[0]
-    if best_it == 1:
+    started = setup.options.complex_candidate == "start"
+    if started:
+        first = history[0]
+    else:  # its mixed µ on the design grid, as D-G-K's D/G-step takes it
+        from .steps.dgstep import MussvStep
+
+        first = MussvStep(setup)(mu_part(lft(setup.G, rival.K), setup.struct), rival.K)
+        first = MusynIteration(index=0, gamma=float("nan"), mu_peak=first.mu_peak,
+                               mu_lower_peak=first.lower_peak, peak_omega=first.peak_omega,
+                               dfit_orders=(), controller_order=rival.K.nstates,
+                               seconds_k=0.0, seconds_d=0.0, seconds_fit=0.0)
+    if started and best_it == 1:
         why = ("; the complexified D-K's controller is returned (D-G-K's first iterate: "
                f"mixed µ {peak:.4f}; no D-G-K iterate beat it)")
         return K, CL_full, CL, dense, final, 1, stop_reason + why, replace(rival,
@@ -912,7 +969,8 @@ def _against_complex(setup, rival: _ComplexStart, history, mine, best_it: int,
         why = (f"; the complexified D-K's controller is returned (mixed µ {peak_r:.4f}): "
                f"D-G-K's best iterate {best_it} certified {peak:.4f} on the dense grid")
         logger.info("musyn: %s", why[2:])
-        return rival.K, CLr_full, CLr, dense_r, final_r, 1, stop_reason + why, rival
+        return (rival.K, CLr_full, CLr, dense_r, final_r, 1 if started else 0,
+                stop_reason + why, rival)
     why = (f"; D-G-K's controller (mixed µ {peak:.4f}) is returned: the complexified "
            f"D-K's certified {peak_r:.4f}")
     return K, CL_full, CL, dense, final, best_it, stop_reason + why, rival
