@@ -484,6 +484,8 @@ def test_a_time_budget_ends_both_phases_after_their_first_iterate_and_says_so(mo
         MusynOptions(time_budget=0.0)
     with pytest.raises(ParameterError):
         MusynOptions(max_gfit_poles=0)
+    with pytest.raises(ParameterError):
+        MusynOptions(complex_candidate="complex")
 
 
 def test_max_gfit_poles_caps_the_states_the_g_scalings_add(loop, monkeypatch):

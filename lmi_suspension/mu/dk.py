@@ -251,26 +251,28 @@ class MusynOptions:
         mixed scaling with G = 0, so the returned mixed µ is no higher than the
         complexified run's controller certifies.  ``"keep"``: D-G-K starts as without
         it (from the central controller, or ``K0``); ``"start"``: D-G-K starts from the
-        complexified run's controller (its first iterate, as ``K0``).  From the central
-        controller D-G-K went further on both problems measured (2026-12-02): the
-        oscillator of ``tests/test_dgk.py``, 1.0391 from the complex controller (its
-        third K-step failed) against 1.0069; the two-mass plant of ``tests/test_dgk.py``,
-        1.7778 (the second K-step failed) against 1.6117.  ``stop_reason`` says which
+        complexified run's controller (its first iterate, as ``K0``).  Neither start wins
+        everywhere (2026-12-02, ``docs/guide/dk.md``): on the two-mass plant
+        (:func:`~lmi_suspension.examples.uncertain_two_mass`) D-G-K from the central
+        controller reached 1.6117 where from the complexified one its second K-step
+        failed (1.7778, the complexified controller, in 93 s against 162 s); on the
+        oscillator of ``tests/test_dgk.py`` 1.0659 against 1.0391, both in about 60 s
+        (complexified D-K: 1.7778 in 68 s and 1.1140 in 44 s).  ``stop_reason`` says which
         controller is returned (``best_iteration`` 0: the complexified run's) and
         :attr:`MusynResult.complex_run` holds that run.  ``None``: D-G-K alone, which
         can end above complex D-K (the seat over m3 and k1: 2.734 against 2.671,
-        2026-11-27; the two-mass plant with 10 G poles: 2.7340 against 2.6355, its
-        second K-step failing, 2026-12-02).  With ``K0``, the complexified run starts
+        2026-11-27; the two-mass plant weighted 1 and 1, with 10 G poles: 2.7340 against
+        2.6355, its second K-step failing, 2026-12-02).  With ``K0``, the complexified run starts
         from it.
     max_gfit_poles : int or None
         D-G-K: the largest basis of the G-scalings (poles per real block; each adds
         three states to the scaled plant per real channel, so this bounds the order of
         the plant every K-step sees, as MATLAB's ``FitOrder`` does).  None: as many as
         keep those states within 30 (10 poles for one real channel, 3 for two; the
-        basis sizes tried are 3, 6 and 10).  On the two-mass plant of
-        ``tests/test_dgk.py`` with 10 poles (60 states) the second K-step's LMI grew
-        past 4 GB; with 3 (a 38-state scaled plant) it took 13-16 s and the run
-        811 MB (2026-12-02).
+        basis sizes tried are 3, 6 and 10).  On the two-mass plant
+        (:func:`~lmi_suspension.examples.uncertain_two_mass`) with 10 poles (60 states)
+        the second K-step's LMI grew past 4 GB; with 3 (a 38-state scaled plant) it
+        took 13-16 s and the run 811 MB (2026-12-02).
     time_budget : float or None
         Seconds of wall time for the iterations (the complexified run of
         ``complex_candidate`` included): after an iterate, where the time spent plus one
@@ -322,6 +324,9 @@ class MusynOptions:
                                  f"{self.dscale_overrelax!r}")
         if int(self.dscale_search) < 0:
             raise ParameterError(f"dscale_search must be >= 0, got {self.dscale_search!r}")
+        if self.complex_candidate not in ("keep", "start", None):
+            raise ParameterError(f"complex_candidate must be 'keep', 'start' or None, got "
+                                 f"{self.complex_candidate!r}")
         if self.max_gfit_poles is not None and int(self.max_gfit_poles) < 1:
             raise ParameterError(f"max_gfit_poles must be >= 1, got {self.max_gfit_poles!r}")
         if self.time_budget is not None and not (
@@ -1070,7 +1075,7 @@ def _over_budget(opts, t_start: float, t_prev: float, it: int, best_it: int) -> 
     if spent + (now - t_prev) <= opts.time_budget:
         return None
     done = (f"time budget of {opts.time_budget:g} s: {spent:.1f} s spent after iteration "
-            f"{it}, another would not fit; the best iterate ({best_it}) is returned")
+            f"{it}, another would not fit; ending with the best iterate so far ({best_it})")
     logger.info("musyn: %s", done)
     return done
 

@@ -133,7 +133,7 @@ def _scaled(G, nmeas, ncon, fit, struct, free):
 #: states the G-scalings may add to the scaled plant when ``MusynOptions.max_gfit_poles``
 #: is None (three per basis pole and real channel, :mod:`..gfit`).  On the oscillator of
 #: tests/test_dgk.py (one real channel) 10 poles, 30 states, took D-G-K to 1.0069
-#: (2026-11-27); on the two-mass plant of tests/test_dgk.py (two real channels) 10 poles,
+#: (2026-11-27); on examples.uncertain_two_mass (two real channels) 10 poles,
 #: 60 states, took the second K-step's LMI past 4 GB (allocation failure under
 #: ``ulimit -v 4000000``), 3 poles, 18 states, kept the run at 811 MB (2026-12-02)
 _G_STATES_MAX = 30
