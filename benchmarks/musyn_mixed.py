@@ -7,7 +7,8 @@ the problem (``two_mass``: :func:`~lmi_suspension.examples.uncertain_two_mass`,
 :func:`~lmi_suspension.examples.stiffness_oscillator` on ``bench_dgk.py``'s 40-point
 grid without the D-scale search), the others ``MusynOptions`` keywords.  Run it under
 ``ulimit -v 4000000`` and ``timeout``: D-G-K with 10 G poles on the two-mass plant
-(``complex_candidate=None, max_gfit_poles=10``) grew past 4 GB (2026-12-02).
+(``complex_candidate=None, max_gfit_poles=10``) filled a 4 GB address space at its
+second K-step (2026-12-02).
 """
 
 import ast

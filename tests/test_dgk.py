@@ -130,7 +130,10 @@ def test_optimal_gscales_reach_the_pointwise_mixed_bound_and_certify_on_the_grid
 def test_musyn_with_real_blocks_kept_real_returns_certified_bounds():
     """complexify=False (D-G-K, the default): whatever its path, the returned controller
     stabilises the loop, its µ bounds use the real structure (lower <= upper on the
-    dense grid, both from mussv on the returned loop), and it is the best iterate."""
+    dense grid, both from mussv on the returned loop), and it is the best iterate, or
+    the complexified run's controller where that certifies lower on the dense grid
+    (``complex_candidate``; on this grid it does: D-G-K's iterate 2 reads 1.1456 on
+    the design grid and rises above it between the points, 2026-12-02)."""
     P = oscillator()
     res = musyn(P, 1, 1, BLK, omega=np.logspace(-2, 1.5, 25),
                 options=MusynOptions(max_iter=2, method="riccati", complexify=False,
@@ -139,7 +142,11 @@ def test_musyn_with_real_blocks_kept_real_returns_certified_bounds():
     assert np.all(np.asarray(res.mu.lower) <= np.asarray(res.mu.upper) * (1 + 1e-6))
     assert res.mu.blk.to_blk().tolist() == BLK
     peaks = [h.mu_peak for h in res.history]
-    assert res.best_iteration == int(np.argmin(peaks)) + 1
+    if res.best_iteration == 0:
+        assert res.K is res.complex_run.K and res.complex_run.mu_peak == res.mu_peak
+        assert "the complexified D-K's controller is returned" in res.stop_reason
+    else:
+        assert res.best_iteration == int(np.argmin(peaks)) + 1
     again = mussv(freqresp(res.CL, [res.peak_omega]), BLK)
     assert float(np.ravel(again.upper)[0]) == pytest.approx(res.mu_peak, rel=1e-3)
 
@@ -514,7 +521,7 @@ def test_max_gfit_poles_caps_the_states_the_g_scalings_add(loop, monkeypatch):
         assert PG.nstates <= P.nstates + 3 * sizes[-1]
 
 
-@pytest.mark.slow  # 190 s on Zen 1 (2026-12-02): the second tier
+@pytest.mark.slow  # 290 s on Zen 1 (2026-12-02): the second tier
 def test_two_mass_mixed_musyn_is_no_worse_than_its_complexified_controller():
     """The two-mass plant (two real parameters, issue 64): default ``musyn`` runs the
     complexified D-K and D-G-K, and returns the lower certified mixed µ.  Checked apart

@@ -271,7 +271,8 @@ class MusynOptions:
         keep those states within 30 (10 poles for one real channel, 3 for two; the
         basis sizes tried are 3, 6 and 10).  On the two-mass plant
         (:func:`~lmi_suspension.examples.uncertain_two_mass`) with 10 poles (60 states)
-        the second K-step's LMI grew past 4 GB; with 3 (a 38-state scaled plant) it
+        the second K-step's LMI filled a 4 GB address space (``ulimit -v``; the
+        issue measured 9 GB resident on its plant); with 3 (a 38-state scaled plant) it
         took 13-16 s and the run 811 MB (2026-12-02).
     time_budget : float or None
         Seconds of wall time for the iterations (the complexified run of

@@ -133,9 +133,10 @@ def _scaled(G, nmeas, ncon, fit, struct, free):
 #: states the G-scalings may add to the scaled plant when ``MusynOptions.max_gfit_poles``
 #: is None (three per basis pole and real channel, :mod:`..gfit`).  On the oscillator of
 #: tests/test_dgk.py (one real channel) 10 poles, 30 states, took D-G-K to 1.0069
-#: (2026-11-27); on examples.uncertain_two_mass (two real channels) 10 poles,
-#: 60 states, took the second K-step's LMI past 4 GB (allocation failure under
-#: ``ulimit -v 4000000``), 3 poles, 18 states, kept the run at 811 MB (2026-12-02)
+#: (2026-11-27); on examples.uncertain_two_mass (two real channels) 10 poles, 60
+#: states, the second K-step's LMI filled a 4 GB address space (a 784 MB allocation
+#: failed under ``ulimit -v 4000000``), 3 poles, 18 states, kept the run at 811 MB
+#: resident (2026-12-02)
 _G_STATES_MAX = 30
 
 
