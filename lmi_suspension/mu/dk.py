@@ -259,7 +259,8 @@ class MusynOptions:
         oscillator of ``tests/test_dgk.py`` 1.0659 against 1.0391, both in about 60 s
         (complexified D-K: 1.7778 in 68 s and 1.1140 in 44 s).  ``stop_reason`` says which
         controller is returned (``best_iteration`` 0: the complexified run's) and
-        :attr:`MusynResult.complex_run` holds that run.  ``None``: D-G-K alone, which
+        :attr:`MusynResult.complex_run` holds that run (its records do not go to
+        ``callback``).  ``None``: D-G-K alone, which
         can end above complex D-K (the seat over m3 and k1: 2.734 against 2.671,
         2026-11-27; the two-mass plant weighted 1 and 1, with 10 G poles: 2.7340 against
         2.6355, its second K-step failing, 2026-12-02).  With ``K0``, the complexified run starts
