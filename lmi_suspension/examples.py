@@ -12,7 +12,7 @@ import control
 import numpy as np
 
 __all__ = ["COMPLEIB_PROBLEMS", "ExamplePlant", "compleib", "skogestad_distillation",
-           "stiffness_oscillator", "uncertain_stiffness_oscillator"]
+           "stiffness_oscillator", "uncertain_stiffness_oscillator", "uncertain_two_mass"]
 
 
 @dataclass(frozen=True)
@@ -122,6 +122,45 @@ def uncertain_stiffness_oscillator(zeta: float = 0.02, rk: float = 0.5, wp: floa
     C = [[0, 0, wp], [0, 0, 0], [1, 0, 0]]
     D = [[0, 0, 0], [0, 0, wu], [0, 0.05, 0]]
     return uss(A, B, C, D)
+
+
+def uncertain_two_mass(wp: float = 0.5, wu: float = 0.5, c: float = 0.05,
+                       noise: float = 0.01):
+    """Two masses on an uncertain spring, a mixed-µ problem with two real parameters.
+
+    ``m1 x1'' = u - f``, ``m2 x2'' = f + d``, ``f = k (x1 - x2) + c (x1' - x2')`` with
+    ``m1 = 1``, ``k = ureal("k", 1, plusminus=0.4)`` and ``m2 = ureal("m2", 1,
+    plusminus=0.3)`` (each appears once: :func:`~lmi_suspension.uncertain.lftdata`
+    finds ``[[-1, 0], [-1, 0]]``); the control force acts on m1, the disturbance force on
+    m2, the position of m2 is measured with ``noise`` (1 %) and weighted ``wp``, the
+    control ``wu``.  Both masses are free (the rigid-body mode is a double pole at 0),
+    as in the ACC robust-control benchmark.  A problem of this project (issue 64,
+    ``tests/test_dgk.py``): inputs ``[d, n, u]``, outputs ``[e_x2, e_u, y]``, 4 states.
+
+    Examples
+    --------
+    >>> from lmi_suspension.uncertain import lftdata
+    >>> data = lftdata(uncertain_two_mass())
+    >>> data.blk.to_blk().tolist(), data.M.nstates
+    ([[-1, 0], [-1, 0]], 4)
+    """
+    from .uncertain import connect, ureal, uss
+
+    k = ureal("k", 1.0, plusminus=0.4)
+    m2 = ureal("m2", 1.0, plusminus=0.3)
+    mass1 = uss([[0, 1], [0, 0]], [[0, 0], [1, -1]], [[1, 0], [0, 1]], [[0, 0], [0, 0]],
+                inputs=["u", "fs"], outputs=["x1", "v1"])
+    mass2 = uss([[0, 1], [0, 0]], [[0], [1 / m2]], [[1, 0], [0, 1]], [[0], [0]],
+                inputs=["f2"], outputs=["x2", "v2"])
+    spring = uss(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), [[k]],
+                 inputs=["dx"], outputs=["fk"])
+    dx = control.summing_junction(inputs=["x1", "-x2"], output="dx")
+    fs = control.ss([], [], [], [[1.0, c, -c]], inputs=["fk", "v1", "v2"], outputs=["fs"])
+    f2 = control.summing_junction(inputs=["fs", "d"], output="f2")
+    out = control.ss([], [], [], [[wp, 0, 0], [0, wu, 0], [1, 0, noise]],
+                     inputs=["x2", "u", "n"], outputs=["e1", "e2", "y"])
+    return connect([mass1, mass2, spring, dx, fs, f2, out], inputs=["d", "n", "u"],
+                   outputs=["e1", "e2", "y"])
 
 
 #: the COMPleib problems shipped in ``lmi_suspension/data/compleib_subset.json``

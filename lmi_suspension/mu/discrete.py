@@ -81,7 +81,10 @@ def musyn_discrete(musyn, G: GeneralizedPlant, nmeas: int, ncon: int, blk, *, om
                              else float(_back(res.mu.peak_omega, dt)))
     return dataclasses.replace(
         res, K=K, CL=CL, peak_omega=peak_omega, mu=mu, omega=_back(res.omega, dt),
-        history=tuple(to_discrete(r) for r in res.history), warnings=tuple(warnings))
+        history=tuple(to_discrete(r) for r in res.history), warnings=tuple(warnings),
+        complex_run=None if res.complex_run is None else dataclasses.replace(
+            res.complex_run, K=tustin(res.complex_run.K, dt),
+            history=tuple(to_discrete(r) for r in res.complex_run.history)))
 
 
 def _back(omega_c, dt: float):

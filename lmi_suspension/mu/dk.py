@@ -241,6 +241,49 @@ class MusynOptions:
         ``tests/test_dgk.py`` (±50 % real stiffness, 40-point grid, no D-scale search;
         2026-11-27): complex D-K ends at mixed µ 1.1326, D-G-K at 1.0069 (iteration 5;
         ``benchmarks/bench_dgk.py``, figures in ``docs/guide/dk.md``).
+    complex_candidate : {"keep", "start"} or None
+        D-G-K only (real blocks kept real): first run the complexified D-K
+        (``complexify=True``, the same options; its D-scale search included, its
+        dense-grid certificate not), then D-G-K, and return whichever controller
+        certifies the lower mixed µ on the dense grid (the complexified one's mixed µ is
+        first taken on the design grid, and on the dense grid only where D-G-K's
+        certified peak is above its lower bound there).  The complex D is a feasible
+        mixed scaling with G = 0, so the returned mixed µ is no higher than the
+        complexified run's controller certifies.  ``"keep"``: D-G-K starts as without
+        it (from the central controller, or ``K0``); ``"start"``: D-G-K starts from the
+        complexified run's controller (its first iterate, as ``K0``).  Neither start wins
+        everywhere (2026-12-02, ``docs/guide/dk.md``): on the two-mass plant
+        (:func:`~lmi_suspension.examples.uncertain_two_mass`) D-G-K from the central
+        controller reached 1.6117 where from the complexified one its second K-step
+        failed (1.7778, the complexified controller, in 93 s against 162 s); on the
+        oscillator of ``tests/test_dgk.py`` 1.0659 against 1.0391, both in about 60 s
+        (complexified D-K: 1.7778 in 68 s and 1.1140 in 44 s).  ``stop_reason`` says which
+        controller is returned (``best_iteration`` 0: the complexified run's) and
+        :attr:`MusynResult.complex_run` holds that run (its records do not go to
+        ``callback``).  ``None``: D-G-K alone, which
+        can end above complex D-K (the seat over m3 and k1: 2.734 against 2.671,
+        2026-11-27; the two-mass plant weighted 1 and 1, with 10 G poles: 2.7340 against
+        2.6355, its second K-step failing, 2026-12-02).  With ``K0``, the complexified run starts
+        from it.
+    max_gfit_poles : int or None
+        D-G-K: the largest basis of the G-scalings (poles per real block; each adds
+        three states to the scaled plant per real channel, so this bounds the order of
+        the plant every K-step sees, as MATLAB's ``FitOrder`` does).  None: as many as
+        keep those states within 30 (10 poles for one real channel, 3 for two; the
+        basis sizes tried are 3, 6 and 10).  On the two-mass plant
+        (:func:`~lmi_suspension.examples.uncertain_two_mass`) with 10 poles (60 states)
+        the second K-step's LMI filled a 4 GB address space (``ulimit -v``; the
+        issue measured 9 GB resident on its plant); with 3 (a 38-state scaled plant) it
+        took 13-16 s and the run 811 MB (2026-12-02).
+    time_budget : float or None
+        Seconds of wall time for the iterations (the complexified run of
+        ``complex_candidate`` included): after an iterate, where the time spent plus one
+        more iteration as long as the last would pass it, the run stops and returns the
+        best iterate so far, certified as ever, and ``stop_reason`` says so.  The unit
+        is the iteration (a K-step is not interrupted, at least one iterate is made),
+        the D-scale search is skipped where the budget ends the run at the first
+        iterate, and the dense-grid certificate of the returned controller comes after
+        the budget (on the two-mass plant, 45 s of mixed-µ LMIs).
     """
 
     max_iter: int = 8
@@ -258,6 +301,9 @@ class MusynOptions:
     dscale_overrelax: float = 2.0
     dscale_search: int = 200
     complexify: bool = False
+    complex_candidate: str | None = "keep"
+    max_gfit_poles: int | None = None
+    time_budget: float | None = None
 
     def __post_init__(self):
         if int(self.max_iter) < 1 or int(self.patience) < 1:
@@ -280,6 +326,16 @@ class MusynOptions:
                                  f"{self.dscale_overrelax!r}")
         if int(self.dscale_search) < 0:
             raise ParameterError(f"dscale_search must be >= 0, got {self.dscale_search!r}")
+        if self.complex_candidate not in ("keep", "start", None):
+            raise ParameterError(f"complex_candidate must be 'keep', 'start' or None, got "
+                                 f"{self.complex_candidate!r}")
+        if self.max_gfit_poles is not None and int(self.max_gfit_poles) < 1:
+            raise ParameterError(f"max_gfit_poles must be >= 1, got {self.max_gfit_poles!r}")
+        if self.time_budget is not None and not (
+                isinstance(self.time_budget, (int, float)) and not isinstance(
+                    self.time_budget, bool) and self.time_budget > 0):
+            raise ParameterError(f"time_budget must be None or a positive number of "
+                                 f"seconds, got {self.time_budget!r}")
 
 
 @dataclass(frozen=True)
@@ -376,7 +432,8 @@ class MusynResult:
         on the dense grid above the γ certified for that controller on its scaled
         plant: one of the two certificates is then wrong).
     best_iteration : int
-        Index of the iteration whose controller is returned.
+        Index of the iteration whose controller is returned; 0 where it is the
+        complexified run's (``MusynOptions.complex_candidate``, ``complex_run.K``).
     stop_reason : str
         Why the loop stopped.
     reduced_from : int or None
@@ -391,6 +448,10 @@ class MusynResult:
     certificates : tuple of SpecificationCertificate
         With ``constraints``: each constraint recomputed on ``F_l(P, K)`` for the
         returned controller (every one met).
+    complex_run : object or None
+        D-G-K with ``MusynOptions.complex_candidate``: the complexified D-K run whose
+        controller was a candidate (``K``, ``history``, ``stop_reason``, ``seconds``, and
+        ``mu_peak``, its mixed µ on the dense grid where the choice needed it).
     """
 
     K: control.StateSpace
@@ -410,9 +471,39 @@ class MusynResult:
     certificates: tuple = ()
     warnings: tuple = ()
     mu_bound: float = float("nan")
+    complex_run: _ComplexRun | None = field(default=None, repr=False)
 
     def __iter__(self):
         return iter((self.K, self.CL, self.mu_peak, self))
+
+
+@dataclass(frozen=True)
+class _ComplexRun:
+    """The complexified D-K run whose controller D-G-K must beat
+    (``MusynOptions.complex_candidate``).
+
+    Attributes
+    ----------
+    K : control.StateSpace
+        Its best controller (lowest complex µ on the design grid): a candidate for the
+        returned controller (and D-G-K's first iterate with ``"start"``).
+    history : tuple of MusynIteration
+        Its iterations (complex µ) and D-scale search.
+    stop_reason : str
+        Why it stopped.
+    seconds : float
+        Its wall time.
+    mu_peak : float or None
+        Its controller's mixed µ peak on the dense grid, where the final comparison
+        computed it (None where D-G-K's result was already no higher than that
+        controller's mixed µ lower bound on the design grid).
+    """
+
+    K: control.StateSpace
+    history: tuple
+    stop_reason: str
+    seconds: float
+    mu_peak: float | None = None
 
 
 def default_omega(P, n: int = 60) -> np.ndarray:
@@ -604,10 +695,7 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         size is not ``ncon x nmeas``, ``DiscreteTimeError`` if it is discrete).
     """
     from ..synthesis.hinfsyn import _hinfsyn as hinfsyn  # the D-scale search's
-    from .steps import NextPlant
-    from .steps.dgstep import MussvStep
-    from .steps.fit import default_fit
-    from .steps.kstep import GivenFirst, default_kstep
+    from .steps.kstep import _GivenController
 
     G_d = _discrete_plant(P, nmeas, ncon)
     if G_d is not None:
@@ -619,10 +707,41 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
     t_start = time.perf_counter()
     setup, given = _setup(P, nmeas, ncon, blk, omega, options, rng, constraints,
                           lyapunov_scales, K0)
+    steps = steps if steps is not None else DKSteps()
+    rival = None
+    mode = setup.options.complex_candidate
+    if setup.mixed and mode is not None:
+        # the complex D is a feasible mixed scaling with G = 0: the complexified run's
+        # controller is a candidate D-G-K must beat ("start": D-G-K starts from it)
+        cx_setup = replace(setup, mixed=False, dk_struct=_complexified(setup.struct),
+                           options=replace(setup.options, complexify=True))
+        cx_best, cx_history, cx_stop = _dk_loop(cx_setup, steps, given, None, hinfsyn,
+                                                t_start)
+        rival = _ComplexRun(K=cx_best[1], history=tuple(cx_history), stop_reason=cx_stop,
+                              seconds=time.perf_counter() - t_start)
+        logger.info("musyn: complexified D-K ended at complex µ %.4f in %.1f s (%s)",
+                    cx_best[0], rival.seconds, cx_stop)
+    if rival is not None and mode == "start":
+        given = _GivenController(rival.K, float(hinfnorm(mu_part(lft(setup.G, rival.K),
+                                                                  setup.struct))[0]),
+                                 ("the complexified D-K's controller: no K-step",))
+    best, history, stop_reason = _dk_loop(setup, steps, given, callback, hinfsyn, t_start)
+    return _certified(setup, best, history, stop_reason, t_start, rival=rival)
+
+
+def _dk_loop(setup, steps: DKSteps, given, callback, hinfsyn, t_start: float):
+    """The D-K (or D-G-K) iterations and the D-scale search of one run:
+    ``(best, history, stop_reason)``, ``best = (mu_peak, K, index)`` on the design grid
+    (``setup.dk_struct``'s µ), nothing certified on the dense grid yet."""
+    from .steps import NextPlant
+    from .steps.dgstep import MussvStep
+    from .steps.fit import default_fit
+    from .steps.kstep import GivenFirst, default_kstep
+
     opts, rng, omega, struct, constraints, mixed, G = (
         setup.options, setup.rng, setup.omega, setup.struct, setup.constraints,
         setup.mixed, setup.G)
-    steps = steps if steps is not None else DKSteps()
+    nmeas, ncon = setup.nmeas, setup.ncon
     kstep = (steps.kstep or default_kstep)(setup)
     if given is not None:
         kstep = GivenFirst(given, kstep)
@@ -634,6 +753,7 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
     searched = None  # the D-scale search's record, from iteration 1's D-step
     stop_reason = f"reached max_iter={opts.max_iter}"
     since_best = 0
+    t_last = None  # start of the previous iteration (the time budget's estimate)
     nxt = NextPlant(PD=G.sys, orders=(), K_ref=None)  # the plant of the next K-step
     for it in range(1, int(opts.max_iter) + 1):
         t0 = time.perf_counter()
@@ -676,11 +796,14 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         excused = getattr(fitstep, "restarts_from_best", False) and best[2] != it
         done = _done(setup, it, mu_peak, float(syn.gamma), gamma_prev, since_best,
                      excused=excused)
+        over = _over_budget(opts, t_start, t0 if t_last is None else t_last, it, best[2])
+        t_last = t0
+        done = done if done is not None or over is None else over
 
         # the D-scale search starts from this D-step, so it runs now, and the D-K
         # iterations after it measure their progress against it; its own copy of the
         # generator leaves them as they are without it
-        if it == 1 and _search_applies(setup, best):
+        if it == 1 and over is None and _search_applies(setup, best):
             searched = _search_stage(G, nmeas, ncon, setup.dk_struct, omega,
                                      (here.d_blocks, here.upper), opts, copy.deepcopy(rng),
                                      index=0, hinfsyn=hinfsyn)
@@ -724,7 +847,7 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         if _search_wins(searched, history[best[2] - 1], setup):
             best = (searched.mu_peak, searched.K, len(history))
             stop_reason += f"; D-scale search to µ {searched.mu_peak:.4f}"
-    return _certified(setup, best, history, stop_reason, t_start)
+    return best, history, stop_reason
 
 
 def _search_wins(searched: MusynIteration, dk_best: MusynIteration, setup) -> bool:
@@ -756,18 +879,18 @@ def _search_applies(setup, best) -> bool:
     return True
 
 
-def _certified(setup, best, history, stop_reason: str, t_start: float) -> MusynResult:
+def _certified(setup, best, history, stop_reason: str, t_start: float,
+               rival: _ComplexRun | None = None) -> MusynResult:
     """The best iterate's result: its µ on a dense grid with the true structure (the
     peak refined with the LMI bound, bounded between grid points), its controller
     reduced where asked and µ allows, its constraints recomputed."""
     _, K, best_it = best
-    G, struct, omega, opts, rng, constraints, mixed = (
-        setup.G, setup.struct, setup.omega, setup.options, setup.rng, setup.constraints,
-        setup.mixed)
-    CL_full = lft(G, K)
-    CL = balanced_statespace(mu_part(CL_full, struct))
-    dense = _dense_grid(omega, int(opts.n_dense), history[best_it - 1].peak_omega, CL)
-    final = _final_bounds(CL, struct, dense, rng)
+    omega, rng, constraints, mixed = setup.omega, setup.rng, setup.constraints, setup.mixed
+    if rival is None:
+        CL_full, CL, dense, final = _dense_certificate(setup, K, history[best_it - 1].peak_omega)
+    else:
+        (K, best_it, CL_full, CL, dense, final, stop_reason,
+         rival) = _against_complex(setup, rival, history, best, stop_reason)
     reduced_from, K_full, mu_full = None, None, None
     reduced = _reduction(setup, K, final, dense, rng)
     if reduced is not None:
@@ -778,7 +901,7 @@ def _certified(setup, best, history, stop_reason: str, t_start: float) -> MusynR
     checks: tuple = ()
     mu_bound = float("inf")
     # (a D-G-K iterate's γ is the norm of a G-scaled plant, not a bound of µ)
-    if reduced_from is None and not (mixed and best_it > 1):
+    if reduced_from is None and not (mixed and best_it != 1):
         # the dense grid reaches below the design grid, where a certificate computed on
         # the scaled plant can fail: the returned loop's µ is the witness.  Its record
         # was reported already, so the finding goes to the result, not into the record.
@@ -799,8 +922,72 @@ def _certified(setup, best, history, stop_reason: str, t_start: float) -> MusynR
         best_iteration=best_it, stop_reason=stop_reason, reduced_from=reduced_from,
         K_full=K_full, mu_peak_full=mu_full,
         seconds=time.perf_counter() - t_start, omega=omega,
-        certificates=certificates(constraints, CL_full), warnings=checks)
+        certificates=certificates(constraints, CL_full), warnings=checks,
+        complex_run=rival)
 
+
+def _dense_certificate(setup, K, peak_omega: float):
+    """``(CL_full, CL, dense, final)``: ``K``'s loop and its µ bounds on the dense grid
+    (:func:`_dense_grid`, :func:`_final_bounds`)."""
+    CL_full = lft(setup.G, K)
+    CL = balanced_statespace(mu_part(CL_full, setup.struct))
+    dense = _dense_grid(setup.omega, int(setup.options.n_dense), peak_omega, CL)
+    return CL_full, CL, dense, _final_bounds(CL, setup.struct, dense, setup.rng)
+
+
+def _against_complex(setup, rival: _ComplexRun, history, best, stop_reason: str):
+    """D-G-K's best controller against the complexified D-K's (``complex_candidate``),
+    both certified with mixed µ on the dense grid: the lower is returned.  Returns
+    ``(K, best_iteration, CL_full, CL, dense, final, stop_reason, rival)`` of the chosen
+    one (``best_iteration`` 0 for the complexified run's, unless it is D-G-K's first
+    iterate), ``stop_reason`` saying which, ``rival`` with its µ where computed.
+
+    The dense certificate (400+ mixed-µ LMIs, 45 s on the two-mass plant) is the costly
+    part, so the controller with the lower µ on the design grid is certified first, and
+    the other only where that certified peak is above the other's µ lower bound on the
+    design grid (below it, the other's µ cannot be lower)."""
+    _, K, best_it = best
+    started = setup.options.complex_candidate == "start"
+    mine = history[best_it - 1]
+    if started:
+        theirs = history[0]  # D-G-K's first iterate is the complexified run's controller
+    else:  # its mixed µ on the design grid, as D-G-K's D/G-step takes it
+        from .steps.dgstep import MussvStep
+
+        here = MussvStep(setup)(mu_part(lft(setup.G, rival.K), setup.struct), rival.K)
+        theirs = MusynIteration(index=0, gamma=float("nan"), mu_peak=here.mu_peak,
+                                mu_lower_peak=here.lower_peak, peak_omega=here.peak_omega,
+                                dfit_orders=(), controller_order=rival.K.nstates,
+                                seconds_k=0.0, seconds_d=0.0, seconds_fit=0.0)
+    if started and best_it == 1:
+        cert = _dense_certificate(setup, K, mine.peak_omega)
+        peak = float(np.max(cert[3].upper))
+        why = ("; the complexified D-K's controller is returned (D-G-K's first iterate: "
+               f"mixed µ {peak:.4f}; no D-G-K iterate beat it)")
+        return (K, 1, *cert, stop_reason + why, replace(rival, mu_peak=peak))
+    dgk = (K, best_it, mine, "D-G-K's best iterate")
+    cpx = (rival.K, 1 if started else 0, theirs, "the complexified D-K's controller")
+    first, second = (cpx, dgk) if theirs.mu_peak < mine.mu_peak else (dgk, cpx)
+    cert1 = _dense_certificate(setup, first[0], first[2].peak_omega)
+    peak1 = float(np.max(cert1[3].upper))
+    peaks = {first[3]: peak1}
+    chosen, cert = first, cert1
+    if peak1 > second[2].mu_lower_peak:
+        cert2 = _dense_certificate(setup, second[0], second[2].peak_omega)
+        peak2 = float(np.max(cert2[3].upper))
+        peaks[second[3]] = peak2
+        if peak2 < peak1 or (peak2 == peak1 and second is dgk):
+            chosen, cert = second, cert2
+    other = cpx if chosen is dgk else dgk
+    said = (f"{peaks[other[3]]:.4f}" if other[3] in peaks
+            else f"at least {other[2].mu_lower_peak:.4f} on the design grid")
+    name = ("D-G-K's controller" if chosen is dgk else "the complexified D-K's controller")
+    why = f"; {name} is returned (mixed µ {peaks[chosen[3]]:.4f}; {other[3]}: {said})"
+    if chosen is cpx:
+        logger.info("musyn: %s", why[2:])
+    if cpx[3] in peaks:
+        rival = replace(rival, mu_peak=peaks[cpx[3]])
+    return (chosen[0], chosen[1], *cert, stop_reason + why, rival)
 
 
 def _discrete_plant(P, nmeas: int, ncon: int) -> GeneralizedPlant | None:
@@ -877,6 +1064,22 @@ def _done(setup, it: int, mu_peak: float, gamma: float, gamma_prev: float,
     if it == opts.max_iter:
         return f"reached max_iter={opts.max_iter}"
     return None
+
+
+def _over_budget(opts, t_start: float, t_prev: float, it: int, best_it: int) -> str | None:
+    """Why the run stops for its ``time_budget`` after iteration ``it``, or None: where
+    the time spent plus one more iteration as long as the last one (``t_prev`` its start)
+    would pass the budget.  The iterations are the unit: a K-step is not interrupted."""
+    if opts.time_budget is None:
+        return None
+    now = time.perf_counter()
+    spent = now - t_start
+    if spent + (now - t_prev) <= opts.time_budget:
+        return None
+    done = (f"time budget of {opts.time_budget:g} s: {spent:.1f} s spent after iteration "
+            f"{it}, another would not fit; ending with the best iterate so far ({best_it})")
+    logger.info("musyn: %s", done)
+    return done
 
 
 def _k_step_on(kstep, nxt, it: int, setup, *, first: bool):

@@ -424,7 +424,8 @@ def _assemble(real, c, coefs, omega, g, beta) -> GScaleFit:
 
 
 def optimal_gscales(omega, Mt, struct: BlockStructure, poles=None, *,
-                    g_max: float = 5.0, target: float | None = None) -> GScaleFit:
+                    g_max: float = 5.0, target: float | None = None,
+                    max_poles: int | None = None) -> GScaleFit:
     """Rational G-scalings chosen for the bound itself, not fitted to pointwise ones.
 
     With the D-scales already applied (``Mt = D̂ M D̂⁻¹`` on the grid), the mixed-µ
@@ -452,6 +453,10 @@ def optimal_gscales(omega, Mt, struct: BlockStructure, poles=None, *,
         Without ``poles``: the pointwise mixed-µ peak of the loop.  The basis grows
         through ``_G_POLE_COUNTS`` log-spaced poles until the level is within
         ``_G_LEVEL_RTOL`` of it (each pole adds three states to ``H`` and two to ``T``).
+    max_poles : int, optional
+        Without ``poles``: the largest basis tried (sizes of ``_G_POLE_COUNTS`` above it
+        are skipped; below the smallest, that many poles): bounds the states the
+        G-scalings add to the scaled plant.
 
     Returns
     -------
@@ -461,7 +466,9 @@ def optimal_gscales(omega, Mt, struct: BlockStructure, poles=None, *,
     omega = np.asarray(omega, dtype=float).ravel()
     if poles is None and target is not None:
         best = None
-        for n in _G_POLE_COUNTS:
+        counts = _G_POLE_COUNTS if max_poles is None else (
+            tuple(n for n in _G_POLE_COUNTS if n <= max_poles) or (int(max_poles),))
+        for n in counts:
             fit = optimal_gscales(omega, Mt, struct, _log_poles(omega, n), g_max=g_max)
             if best is None or fit.beta < best.beta:
                 best = fit

@@ -130,6 +130,25 @@ def _scaled(G, nmeas, ncon, fit, struct, free):
     return scaled_plant(G, nmeas, ncon, fit, sizes)
 
 
+#: states the G-scalings may add to the scaled plant when ``MusynOptions.max_gfit_poles``
+#: is None (three per basis pole and real channel, :mod:`..gfit`).  On the oscillator of
+#: tests/test_dgk.py (one real channel) 10 poles, 30 states, took D-G-K to 1.0069
+#: (2026-11-27); on examples.uncertain_two_mass (two real channels) 10 poles, 60
+#: states, the second K-step's LMI filled a 4 GB address space (a 784 MB allocation
+#: failed under ``ulimit -v 4000000``), 3 poles, 18 states, kept the run at 811 MB
+#: resident (2026-12-02)
+_G_STATES_MAX = 30
+
+
+def gfit_poles(opts, struct: BlockStructure) -> int:
+    """The largest G basis D-G-K's fit may use: ``opts.max_gfit_poles``, or where that is
+    None, as many as keep the G-scalings' states within ``_G_STATES_MAX``."""
+    if opts.max_gfit_poles is not None:
+        return int(opts.max_gfit_poles)
+    channels = sum(b.rows for b in struct.blocks if b.is_real)
+    return max(1, _G_STATES_MAX // (3 * max(channels, 1)))
+
+
 def _dg_scaled(G, nmeas, ncon, struct, free, M, beta, omega, weights, opts, K_ref):
     """D-G-K's next plant (:mod:`.gfit`): the central D-scalings of the loop ``M`` at
     level ``beta``, fitted; then the G-scalings that minimise the level of ``K_ref``'s
@@ -142,7 +161,7 @@ def _dg_scaled(G, nmeas, ncon, struct, free, M, beta, omega, weights, opts, K_re
                       weights=weights)
     PD = _scaled(G, nmeas, ncon, fit, struct, free)
     Mt = freqresp(mu_part(lft(PD, K_ref, nmeas, ncon), struct), omega)
-    gfit = optimal_gscales(omega, Mt, struct, target=beta)
+    gfit = optimal_gscales(omega, Mt, struct, target=beta, max_poles=gfit_poles(opts, struct))
     logger.info("musyn: D-G scalings at level %.5g for the loop at %.5g", gfit.beta, beta)
     return fit, gscaled_plant(PD, nmeas, ncon, struct, gfit)
 

@@ -1,0 +1,53 @@
+"""Mixed µ-synthesis on the two-mass plant and the stiffness oscillator (issue 64, items
+2 and 3): µ upper and lower bound, controller order, seconds, peak memory, stop reason.
+
+``python benchmarks/musyn_mixed.py two_mass complexify=True`` -- the first argument
+the problem (``two_mass``: :func:`~lmi_suspension.examples.uncertain_two_mass`,
+``musyn(P, 1, 1)`` on the default grid; ``oscillator``:
+:func:`~lmi_suspension.examples.stiffness_oscillator` on ``bench_dgk.py``'s 40-point
+grid without the D-scale search), the others ``MusynOptions`` keywords.  Run it under
+``ulimit -v 4000000`` and ``timeout``: D-G-K with 10 G poles on the two-mass plant
+(``complex_candidate=None, max_gfit_poles=10``) filled a 4 GB address space at its
+second K-step (2026-12-02).
+"""
+
+import ast
+import logging
+import resource
+import sys
+import time
+
+import numpy as np
+
+from lmi_suspension.examples import stiffness_oscillator, uncertain_two_mass
+from lmi_suspension.mu import MusynOptions, musyn
+
+if __name__ == "__main__":
+    logging.basicConfig(level=logging.INFO, format="%(relativeCreated)7.0f %(message)s")
+    for name in ("lmi_suspension.synthesis", "lmi_suspension.lti", "lmi_suspension.mu.dfit",
+                 "lmi_suspension.mu.dsearch", "lmi_suspension.mu.bounds",
+                 "lmi_suspension.mu.gfit"):
+        logging.getLogger(name).setLevel(logging.WARNING)
+    problem = sys.argv[1] if len(sys.argv) > 1 else "two_mass"
+    kw = {k.strip(): ast.literal_eval(v) for k, v in
+          (item.split("=", 1) for item in sys.argv[2:])}
+    t0 = time.perf_counter()
+    if problem == "oscillator":
+        ex = stiffness_oscillator()
+        res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-2, 1.5, 40),
+                    options=MusynOptions(max_iter=8, dscale_search=0, **kw))
+    else:
+        res = musyn(uncertain_two_mass(), 1, 1, options=MusynOptions(**kw))
+    seconds = time.perf_counter() - t0
+    print(f"{problem} {kw}: µ {res.mu_peak:.4f} (lower {res.mu_lower_peak:.4f}), "
+          f"K order {res.K.nstates}, {seconds:.1f} s, best iteration {res.best_iteration}, "
+          f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB")
+    print("stop:", res.stop_reason)
+    if res.complex_run is not None:
+        print(f"complexified run: {res.complex_run.seconds:.1f} s, complex µ per iterate "
+              f"{[round(h.mu_peak, 4) for h in res.complex_run.history]}, its mixed µ "
+              f"{res.complex_run.mu_peak}")
+    for h in res.history:
+        print(h.index, h.stage, f"µ {h.mu_peak:.4f}", f"K {h.controller_order}",
+              f"fits {h.dfit_orders}", f"[K {h.seconds_k:.1f} s, D {h.seconds_d:.1f} s, "
+              f"fit {h.seconds_fit:.1f} s]")
