@@ -73,6 +73,29 @@ def test_the_discrete_optimum_of_a_tustin_plant_is_the_continuous_one(name):
         assert info.gamma_lower == pytest.approx(lower, rel=1e-4)
 
 
+def _own_plants():
+    """Two plants of this project: the unstable scalar plant of hinfsyn's docstring
+    (1/(s - 1), weighted control, measurement noise) and a seeded random 5-state plant
+    with an unstable mode (``synthesis.examples.random_plant``)."""
+    from lmi_suspension.synthesis.examples import random_plant
+
+    scalar = GeneralizedPlant.from_matrices(A=[[1.0]], B1=[[1.0, 0.0]], B2=[[1.0]],
+                                            C1=[[1.0], [0.0]], C2=[[1.0]],
+                                            D12=[[0.0], [1.0]], D21=[[0.0, 1.0]])
+    rand = random_plant(5, 2, 1, 2, 1, rng=np.random.default_rng(63))
+    return {"scalar": scalar, "random5": rand}
+
+
+@pytest.mark.parametrize("name", ["scalar", "random5"])
+def test_the_bilinear_check_on_two_plants_of_our_own(name):
+    P = _own_plants()[name]
+    lower = hinfsyn(P, P.ny, P.nu).gamma_lower
+    Pd = control.sample_system(P.sys, DT, method="tustin")
+    K, CL, gamma, info = hinfsyn(Pd, P.ny, P.nu)
+    assert gamma == pytest.approx(hinfnorm(lft(Pd, K, P.ny, P.nu))[0], rel=1e-9)
+    assert np.all(np.abs(np.linalg.eigvals(np.asarray(CL.A))) < 1)
+    assert lower * (1 - 1e-6) <= gamma <= lower * (1 + BUDGET)
+
 def test_a_tighter_relaxation_reaches_the_continuous_optimum_within_1e_4():
     # where the discrete γ minimisation ends cleanly (AC4, REA1, NN2 measured), a
     # reconstruction 2e-5 above it certifies within 1e-4 of the continuous optimum
