@@ -373,17 +373,11 @@ def _hinfnorm_discrete(A, B, C, D, dt, rtol, max_iter):
     if not _stable_poles(poles, dt, STABILITY_TOL):
         worst = poles[np.argmax(np.abs(poles))]
         return float("inf"), float(abs(np.angle(worst)) / dt)
-    Ac, Bc, Cc, Dc = (np.asarray(M, dtype=float) for M in _abcd_of(
-        tustin_image(control.ss(A, B, C, D, dt))))
-    gamma, wc = _hinfnorm(*balanced_matrices(Ac, Bc, Cc), Dc, rtol, max_iter)
+    # the image balanced like every continuous system here (_matrices)
+    gamma, wc = _hinfnorm(*_matrices(tustin_image(control.ss(A, B, C, D, dt))), rtol, max_iter)
     # ω_c = ∞ is z = -1, the Nyquist rate
     return gamma, (float(tustin_frequency(wc, dt)) if np.isfinite(wc) else np.pi / dt)
 
-
-def _abcd_of(ss):
-    n = ss.nstates
-    return (np.reshape(ss.A, (n, n)), np.reshape(ss.B, (n, ss.ninputs)),
-            np.reshape(ss.C, (ss.noutputs, n)), np.reshape(ss.D, (ss.noutputs, ss.ninputs)))
 
 
 def _hinfnorm(A, B, C, D, rtol: float, max_iter: int) -> tuple[float, float]:
