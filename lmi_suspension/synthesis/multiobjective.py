@@ -499,8 +499,12 @@ def _synthesise(G: GeneralizedPlant, objective, constraints, options, lyapunov_s
         # every rung near the optimum failed: typically an infimum that no controller
         # attains (state feedback on COMPleib AC2: a mode at s = 0 that z does not see,
         # the controllers near the optimum leave a closed-loop pole at -7e-7)
+        # (an optimum of 0, an H2 level on the discrete plants of tests/test_discrete.py,
+        # has no relative distance)
+        above = (f"{certs[0].lmi_level / lmi_level - 1:.1%} above" if lmi_level > 0
+                 else "above")
         warnings.append(f"the controller was reconstructed at {certs[0].lmi_level:.6g}, "
-                        f"{certs[0].lmi_level / lmi_level - 1:.1%} above the LMI optimum "
+                        f"{above} the LMI optimum "
                         f"{lmi_level:.6g}: the optimum may not be attained (slowest "
                         f"closed-loop pole {_worst(poles, Ps.dt)})")
     elif not specs and certs[0].achieved < lmi_level * (1 - _CERT_RTOL):
