@@ -34,9 +34,9 @@ DT = 0.01
 #: AC6, REA2, NN1 and AC2 take longer; every one of the twelve certifies)
 BILINEAR = ["AC4", "HE1", "REA1", "AC3", "DIS1", "NN2"]
 #: the issue's acceptance: certified discrete γ within 1e-4 of the continuous optimum.
-#: Measured 2e-7 to 2.5e-5 on the eight plants at 10 ms (HE1 2.3e-5, AC3 1.2e-5), the
-#: same to two digits under the Haswell, Sandybridge and Nehalem kernels (Zen 1,
-#: 2026-12-02)
+#: Measured -4.6e-7 to 4.5e-5 on the eight plants at 10 ms under the Haswell,
+#: Sandybridge and Nehalem kernels (largest: 1/(s - 1) 4.5e-5, AC3 4.3e-5 under
+#: Sandybridge, HE1 4.1e-5 under Nehalem; Zen 1, 2026-12-02)
 BUDGET = 1e-4
 #: the discrete LMI posed on the discrete data directly (``msyn``, reconstructed 1e-3
 #: above its optimum): measured 3e-9 (REA1) to 9.9e-4 (AC3) above the continuous optimum
