@@ -747,7 +747,8 @@ def _reconstruct(G: GeneralizedPlant, Ps: GeneralizedPlant, sc: PlantScaling,
             np.log10(_WIDE_SIGMA):
         frames[:2] = frames[1::-1]
     if opts.controller == "explicit" and n:
-        found = _explicit(G, Ps, sc, sols[0], g_base, fixed, opts, warnings, pole_cap)
+        found = _explicit(G, Ps, sc, sols[0], g_base, fixed, opts, warnings,
+                          pole_cap=pole_cap)
         if found is not None:
             return found
     lmis: dict = {}
@@ -1021,7 +1022,7 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float,
     # the frame of the optimum first, then (where the γ minimisation was refined) the
     # frame of the round before it
     result = _reconstruct(G, Ps, sc, [sol] + earlier[-1:], g_base, fixed, opts, warnings,
-                          pole_cap)
+                          pole_cap=pole_cap)
     gamma, t_cert = result[2], result[-1]
     t_refine = 0.0
     # a controller that beats the optimum of the minimisation proves it stopped high
@@ -1047,7 +1048,7 @@ def _hinfsyn_lmi(G: GeneralizedPlant, opts: HinfsynOptions, t0: float,
                                          [ref] + earlier[-1:])
         again: list[str] = []
         try:
-            alt = _reconstruct(G, P2, sc2, sols2, g2, fixed, opts, again, pole_cap)
+            alt = _reconstruct(G, P2, sc2, sols2, g2, fixed, opts, again, pole_cap=pole_cap)
         except SolverError as exc:
             warnings.append(f"reconstruction after the refinement failed ({exc})")
             continue
