@@ -202,7 +202,7 @@ def test_an_optimum_no_reconstruction_comes_near_is_not_reported(monkeypatch):
     relax_max = RELAX * mod._RELAX_GROWTH ** HinfsynOptions().max_recoveries
     assert gamma_K > ref * (1 + relax_max)  # the premise: beyond every relaxed level
 
-    def far(G, Ps, sc, sols, g_base, fixed, opts, warnings):
+    def far(G, Ps, sc, sols, g_base, fixed, opts, warnings, pole_cap=None):
         return (K, CL, gamma_K, np.linalg.eigvals(np.asarray(CL.A)),
                 g_base / sc.gamma_factor, "injected", 1.0, 0.0)
 

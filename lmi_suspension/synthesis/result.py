@@ -29,7 +29,9 @@ class HinfsynOptions:
         recovery (``4 gamma_relax``, ``16 gamma_relax``, ...).  The default keeps every
         COMPleib problem of the tests within 0.04 % of the LMI optimum.  It is also the
         margin by which a certified Riccati controller must be sought below
-        ``gamma_lower`` before ``gamma_lower`` is withheld (see ``HinfsynResult``).
+        ``gamma_lower`` before ``gamma_lower`` is withheld (see ``HinfsynResult``).  On a
+        discrete-time plant the reconstruction is at most 5e-5 above the optimum of its
+        bilinear image (``min(gamma_relax, 5e-5)``).
     gamma_atol : float
         Absolute γ floor in scaled units (plant data normalised to about 1): when the LMI
         optimum is below it (an infimum of 0, e.g. COMPleib AC1) the reconstruction
