@@ -277,23 +277,31 @@ def _hinfsyn_discrete(G: GeneralizedPlant, method: str, opts: HinfsynOptions,
     from .constraints import HinfBound
     from .multiobjective import _OUTPUT_FEEDBACK, _synthesise
 
-    if opts.gamma is not None:
-        raise NotBuiltError("hinfsyn at a fixed gamma is built for continuous-time plants "
-                            "only; leave options.gamma unset (the γ-optimal controller)")
     D22 = G.D22
     G0 = _without_d22(G) if np.any(D22) else G
     warnings: list[str] = []
     t1 = time.perf_counter()
+    fixed = opts.gamma is not None
     image = None
     if method == "riccati":
         check_riccati_assumptions(G0)
-        K0, gamma_solver = _scan_sb10dd(G0, opts, warnings)
+        if fixed:
+            Gs, sc = scale_plant(G0)
+            K0 = sc.controller_to_original(_sb10dd(Gs, float(opts.gamma) * sc.gamma_factor))
+            gamma_solver = float(opts.gamma)
+        else:
+            K0, gamma_solver = _scan_sb10dd(G0, opts, warnings)
         gamma_lower, status = None, "optimal"
         K = _undo_loop_shift(K0, D22)
     else:
         image = _bilinear_lmi(G, opts, warnings)
     if image is not None:
         K, gamma_solver, status, gamma_lower = image
+    elif fixed and method != "riccati":
+        raise NotBuiltError("hinfsyn at a fixed gamma on a discrete plant is built on its "
+                            "bilinear image, and this plant has none (a pole at z = -1, "
+                            "see the result's warnings of the gamma-optimal run); leave "
+                            "options.gamma unset")
     elif method != "riccati":
         res = _synthesise(G0, HinfBound(), (), opts, None, _OUTPUT_FEEDBACK, t1,
                           level_relax=opts.gamma_relax)
@@ -356,12 +364,14 @@ def _bilinear_lmi(G: GeneralizedPlant, opts: HinfsynOptions, warnings: list):
             res = _hinfsyn_lmi(Gc, image_opts, time.perf_counter(), pole_cap=cap)
             K = tustin(res.K, G.dt)
             gamma = float(hinfnorm(lft(G, K))[0])
+        # InfeasibleError passes through: at a fixed γ the image's LMIs are the discrete
+        # ones, so infeasible on the image is the plant's answer, not a route's failure
         except (SolverError, ParameterError, IllPosedLoopError, np.linalg.LinAlgError) as exc:
             warnings.append(f"bilinear image (explicit pole cap {cap:g}): {exc}")
             continue
         tried.append((gamma, K, res))
         low = res.gamma_lower
-        if low is not None and \
+        if opts.gamma is not None or low is not None and \
                 gamma <= low * (1.0 + _DISCRETE_RESTART * image_opts.gamma_relax):
             break
     if not tried:
