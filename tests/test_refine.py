@@ -17,9 +17,10 @@ from lmi_suspension.lti import freqresp, lft
 from lmi_suspension.mu import mussv
 from lmi_suspension.seat import refine
 from lmi_suspension.seat.augmented import seat_augmented_plant
-from lmi_suspension.seat.design import DEFAULT_DESIGN, design_mu_controller
-from lmi_suspension.seat.refine import (REFINE_DELAYS, SHIPPED_REFINED, BumpResponse,
-                                        RefineOptions, TwoBlockMu, certify_refined,
+from lmi_suspension.seat.augmented import DEFAULT_DESIGN
+from lmi_suspension.seat.design import design_mu_controller
+from lmi_suspension.seat.loop import REFINE_DELAYS, BumpResponse, TwoBlockMu
+from lmi_suspension.seat.refine import (SHIPPED_REFINED, RefineOptions, certify_refined,
                                         load_refined, modal_form, refine_seat_controller)
 from lmi_suspension.seat.roads import bump
 from lmi_suspension.seat.simulate import simulate
@@ -370,7 +371,7 @@ def test_interconnection_poles_are_the_lfts_and_refuse_a_nonzero_d22():
     """The poles formula (D22 = 0) against the closed loop built by ``lti.lft``; with
     D22 ≠ 0 the formula would be wrong, so it refuses."""
     from lmi_suspension.errors import InputError
-    from lmi_suspension.seat.refine import interconnection_poles
+    from lmi_suspension.seat.loop import interconnection_poles
 
     rng = np.random.default_rng(4)
     nw, nu, nz, ny, n, nk = 2, 1, 2, 2, 5, 3
