@@ -211,7 +211,7 @@ class TwoBlockMu:
             raise ParameterError("omega must hold positive finite frequencies")
         ny, nu = aug.nmeas, aug.ncon
         object.__setattr__(self, "_c", dict(
-            omega=omega, P=aug.P, nz=nz, nw=nw, ny=ny, nu=nu,
+            omega=omega, P=aug.P, blk=aug.blk, nz=nz, nw=nw, ny=ny, nu=nu,
             rows=int(blk[0, 1]), cols=int(blk[0, 0])))
         self._c["grid"] = self._blocks(freqresp(aug.P, omega))
 

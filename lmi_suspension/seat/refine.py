@@ -5,9 +5,12 @@ convex with one Lyapunov matrix for every specification; on the seat that costs 
 performance (µ 0.854 → 2.57) and the force it leaves unused (the bump asks 1095 N of the
 1500 N). This module takes the other classical route, that of structured H∞ tuning
 (MATLAB's ``systune``/``hinfstruct``; Apkarian & Noll, IEEE TAC 51(1), 2006): the
-controller's order is fixed, its real modal realization is the decision vector, and a
-local gradient method (SciPy's SLSQP) minimises the bump's peak upper-body acceleration
-over the delays subject to every requirement *evaluated exactly*, not bounded:
+controller's order is fixed, its real modal realization is the decision vector
+(:func:`~lmi_suspension.tune.tunable_modal`), and :func:`~lmi_suspension.tune.systune`'s
+SLSQP route (SciPy's SLSQP in trust-region stages, :mod:`lmi_suspension.tune.stages`)
+minimises the bump's peak upper-body acceleration over the delays subject to every
+requirement *evaluated exactly*, not bounded -- the requirement classes of
+:mod:`.goals`:
 
 * the bump response at each delay, in closed form in the frequency domain: the loop
   with the exact delay ``e^{-sτ}``, linear and unclipped, transformed back by FFT
@@ -20,8 +23,11 @@ over the delays subject to every requirement *evaluated exactly*, not bounded:
 * the magnitudes of the controller's and the loop's poles (a disk a 1 kHz controller
   resolves) and the loop's stability.
 
-The result is a local optimum from the start it is given, not a global one. It is
-certified by computations that did not produce it (:func:`certify_refined`): the
+This module holds no optimiser of its own: it chooses the requirements, the start and
+the stage lengths, and reads the figures back.  The result is a local optimum from the
+start it is given, not a global one.  ``systune`` recomputes each requirement by
+another route (``RefinedDesign.certificate``), and :func:`certify_refined` certifies
+the controller by computations that did not produce it: the
 exact-delay time simulation at each delay, µ upper and lower bounds of
 :func:`~lmi_suspension.mu.mussv` on a dense grid, and the closed-loop poles.
 """
@@ -36,18 +42,27 @@ from typing import ClassVar
 
 import control
 import numpy as np
-from scipy import linalg, optimize
+from scipy import linalg
 
 from ..errors import DimensionError, ParameterError
 from .augmented import DEFAULT_DESIGN, SeatDesignOptions
-from .loop import _LIMIT_DT, REFINE_DELAYS, BumpResponse, TwoBlockMu, loop_poles
+from .goals import (
+    BumpForce,
+    BumpPeak,
+    BumpStroke,
+    MuBound,
+    PoleDisk,
+    PoleShape,
+    SeatLoops,
+    SeatSeat,
+)
+from .loop import _LIMIT_DT, REFINE_DELAYS, BumpResponse, TwoBlockMu
 from .params import SeatParameters
 from .roads import RoadInput, bump
 
-__all__ = ["RefineOptions", "RefineStage", "RefinedDesign", "SHIPPED_REFINED",
-           "certify_refined", "SHIPPED_REFINED_TRADEOFF", "load_refined",
-           "load_refined_tradeoff", "modal_form",
-           "refine_seat_controller", "save_refined", "RefineRoute"]
+__all__ = ["SHIPPED_REFINED", "SHIPPED_REFINED_TRADEOFF", "RefineOptions", "RefineRoute",
+           "RefineStage", "RefinedDesign", "certify_refined", "load_refined",
+           "load_refined_tradeoff", "modal_form", "refine_seat_controller", "save_refined"]
 
 logger = logging.getLogger(__name__)
 
@@ -157,8 +172,8 @@ def modal_form(K, radius: float | None = None) -> control.StateSpace:
 # ----------------------------------------------------------------------------- the search
 
 #: µ grid of the search, rad/s: the certification grid's range at 200 points; µ is also
-#: taken at its refined local maxima and at the loop's least damped poles (_PEAKS,
-#: _RESONANCES), and the certificate adds its own points.
+#: taken at its refined local maxima and at the loop's least damped poles (see
+#: :mod:`.goals`), and the certificate adds its own points.
 _MU_GRID = np.logspace(-3.0, 4.0, 200)
 #: SLSQP iterations per trust-region stage, and the first stage's box half-width in the
 #: normalised parameters (0.5: a gain may move by half its starting magnitude, a pole by
@@ -182,15 +197,6 @@ _RS_STAGE_ITER = 30
 _RS_TRUST_START = 0.1
 _TRUST_START = 0.5
 _TRUST_MIN = 1e-3
-#: every loop pole's real part must stay below minus this (rad/s), so that the FFT
-#: record decays (see _FFT_HORIZON); the µ controller's slowest is 0.66
-_MIN_DECAY = 0.5
-#: and its damping ratio above this: µ's peak at a pole of damping ζ is about 2ζ wide,
-#: so a grid cannot hide it (the search hid a peak µ 1.72 at 1.9 rad/s from a 150-point
-#: grid, 2026-11-26); the µ controller's least damped loop pole has ζ = 0.52
-_MIN_DAMPING = 0.05
-#: how many of the slowest and the least damped poles carry those constraints
-_SHAPE_POLES = 4
 #: SLSQP ends on the constraints' boundary, a little outside (1.5e-4 relative on µ in
 #: the first trial, which then rejected every later stage as "more violation"), and the
 #: FFT's bump figures differ from the time simulation's by up to 0.2 % (with a margin of
@@ -198,43 +204,6 @@ _SHAPE_POLES = 4
 #: aims at every bound tightened by twice this fraction and counts an excess below it
 #: as met, so that what it returns is within the bounds themselves by about this much.
 _MARGIN = 3e-3
-
-#: µ's largest local maxima on the grid, refined between grid points
-#: (:meth:`TwoBlockMu.peaks`), are constraints too, this many: on the 150-point grid
-#: alone the search hid a resonance at 76 rad/s between two points, µ 0.978 on the grid
-#: and 1.035 at the peak (2026-11-26).
-_PEAKS = 6
-#: µ is also taken at this many least damped loop pole pairs (|p| and |Im p| of each)
-_RESONANCES = 6
-
-
-def _shape_margins(poles: np.ndarray) -> np.ndarray:
-    """Normalised margins (>= 0 where met) of the :data:`_SHAPE_POLES` slowest poles'
-    decay (:data:`_MIN_DECAY`) and least damped poles' damping (:data:`_MIN_DAMPING`)."""
-    decay = np.sort(-poles.real)[:_SHAPE_POLES] / _MIN_DECAY - 1
-    zeta = np.sort(-poles.real / np.maximum(np.abs(poles), 1e-300))[:_SHAPE_POLES]
-    return np.concatenate([decay, zeta / _MIN_DAMPING - 1])
-
-
-def _cover_points(mu: TwoBlockMu, K, poles: np.ndarray) -> list:
-    """The delay cover's gain where it is bounded: on the grid, at its :data:`_PEAKS`
-    largest maxima refined between grid points, and at the loop's resonances
-    (:func:`_resonance_points`), as µ is for robust performance.  On the grid alone the
-    multi-seat design's cover reached µ 0.999 (mixed, dense grid) at 86.6 rad/s between
-    two points of its 200 (2026-11-27)."""
-    curve, top, _ = mu.cover_peaks(K, _PEAKS)
-    return [curve, top, mu.cover_gain(K, _resonance_points(poles))]
-
-
-def _resonance_points(poles: np.ndarray) -> np.ndarray:
-    """``|p|`` and ``|Im p|`` of the :data:`_RESONANCES` least damped pole pairs (the
-    least damped repeated where there are fewer pairs): a fixed number of frequencies."""
-    p = poles[poles.imag > 0]
-    if p.size == 0:
-        return np.ones(2 * _RESONANCES)
-    p = p[np.argsort(-p.real / np.abs(p), kind="stable")]
-    p = np.concatenate([p, np.repeat(p[:1], _RESONANCES)])[:_RESONANCES]
-    return np.concatenate([np.abs(p), p.imag])
 
 
 @dataclass(frozen=True)
@@ -321,184 +290,6 @@ class RefineOptions:
 
 
 @dataclass(frozen=True)
-class _Point:
-    """One controller's exact figures and how far it is from the requirements."""
-
-    z: np.ndarray           # peak |z3''| per seat and delay (over the seat's limit)
-    u: np.ndarray
-    x1: np.ndarray
-    mu_curve: np.ndarray    # µ on the search grid, at its refined peaks and resonances
-    magnitudes: np.ndarray  # controller and loop pole magnitudes, sorted
-    shape: np.ndarray       # decay and damping margins of the slowest / least damped
-    violation: float        # largest normalised excess over a requirement (0: met)
-
-    @property
-    def mu(self) -> float:
-        return float(np.max(self.mu_curve))
-
-    @property
-    def radius(self) -> float:
-        return float(self.magnitudes[-1])
-
-    @property
-    def objective(self) -> float:
-        return float(np.max(self.z))
-
-    def better_than(self, other: "_Point", tol: float = _MARGIN) -> bool:
-        if self.violation > tol or other.violation > tol:
-            return self.violation < other.violation - tol
-        return self.objective < other.objective * (1 - 1e-6)
-
-
-@dataclass(frozen=True)
-class _Seat:
-    """One seat the requirements are evaluated at."""
-
-    bumpr: BumpResponse
-    unit: float                     # of its peak |z3''|: 1 (m/s²) or its own limit
-    params: SeatParameters | None
-    cover: TwoBlockMu | None        # its delay-cover gain (None: the design seat's µ)
-
-
-class _Problem:
-    """The parametrisation (real modal form, normalised) and the exact evaluations."""
-
-    def __init__(self, K0: control.StateSpace, opts: RefineOptions, seats: list,
-                 mu: TwoBlockMu, rs=None):
-        A = np.asarray(K0.A)
-        self.n = A.shape[0]
-        self.kinds, poles, i = [], [], 0
-        while i < self.n:
-            if i + 1 < self.n and A[i, i + 1] != 0.0:
-                self.kinds.append(2)
-                poles += [np.log(-A[i, i]), np.log(A[i, i + 1])]
-                i += 2
-            else:
-                self.kinds.append(1)
-                poles.append(np.log(-A[i, i]))
-                i += 1
-        self.npole = len(poles)
-        gains = np.concatenate([np.asarray(K0.B).ravel(), np.asarray(K0.C).ravel(),
-                                np.asarray(K0.D).ravel()])
-        self.x0 = np.concatenate([poles, gains])
-        # each gain in units of its own magnitude; an entry that is zero (the rotated
-        # pairs' second output gain) in a tenth of its mode's
-        Bk, Ck, Dk = (np.asarray(m, dtype=float) for m in (K0.B, K0.C, K0.D))
-        mode = np.sqrt(np.sum(Bk ** 2, axis=1) + Ck[0] ** 2)
-        floor = np.concatenate([np.repeat(mode, Bk.shape[1]), mode,
-                                np.full(Dk.size, np.linalg.norm(Dk))]) * 0.1
-        floor = np.maximum(floor, 1e-12)
-        self.scale = np.concatenate([np.ones(self.npole), np.maximum(np.abs(gains), floor)])
-        self.opts, self.seats, self.mu = opts, seats, mu
-        # the set's robust stability (MixedRsBound) and the stage's scalings
-        self.rs, self.rs_scal = rs, None
-        tight = 1.0 - 2 * _MARGIN
-        self.bounds = dict(u=opts.u_bound * tight, x1=opts.z_bound * tight,
-                           mu=opts.mu_max * tight, radius=opts.disk_radius * tight)
-        self.ny = np.asarray(K0.B).shape[1]
-        self._cache: dict = {}
-        self.best: _Point | None = None
-        self.size = 0       # of the constraint vector, set from the start point
-        self.best_y: np.ndarray | None = None
-
-    def controller(self, y: np.ndarray) -> control.StateSpace:
-        x = y * self.scale
-        n, ny = self.n, self.ny
-        A = np.zeros((n, n))
-        i = j = 0
-        for k in self.kinds:
-            if k == 1:
-                A[i, i] = -np.exp(x[j])
-            else:
-                sigma, omega = -np.exp(x[j]), np.exp(x[j + 1])
-                A[i:i + 2, i:i + 2] = [[sigma, omega], [-omega, sigma]]
-            i, j = i + k, j + k
-        B = x[j:j + n * ny].reshape(n, ny)
-        C = x[j + n * ny:j + n * ny + n].reshape(1, n)
-        D = x[j + n * ny + n:].reshape(1, ny)
-        return control.ss(A, B, C, D)
-
-    def rescale(self, y: np.ndarray) -> _Point | None:
-        """Optimise the set's scalings for the controller at ``y`` and forget every
-        evaluation made with the previous ones (their µ figures were other bounds)."""
-        self.rs_scal = self.rs.scalings(self.controller(y))
-        self._cache.clear()
-        self.best = self.best_y = None
-        return self.evaluate(y)
-
-    def evaluate(self, y: np.ndarray) -> _Point | None:
-        key = y.tobytes()
-        if key not in self._cache:
-            p = self._cache[key] = self._evaluate(y)
-            # every evaluated point is a controller with exact figures, SLSQP's iterates
-            # and its difference probes alike: the best one is kept, not the last
-            if p is not None and (self.best is None or p.better_than(self.best)):
-                self.best, self.best_y = p, np.array(y, dtype=float)
-        return self._cache[key]
-
-    def _evaluate(self, y):
-        if not np.all(np.isfinite(y)) or np.any(y[:self.npole] > 50):
-            return None
-        K = self.controller(y)
-        with np.errstate(all="ignore"):
-            try:
-                pa = self.mu.loop_poles(K)
-                covers = [(s.cover, s.cover.loop_poles(K)) for s in self.seats
-                          if s.cover is not None]
-                poles = np.concatenate([loop_poles(K, s.params) for s in self.seats] + [pa]
-                                       + [pc for _, pc in covers])
-                # the set's µ loop: its stability only (its weights' poles are not the
-                # loop's shape)
-                if self.rs is not None and np.max(self.rs.loop_poles(K).real) >= 0:
-                    return None
-            except np.linalg.LinAlgError:
-                return None
-            if not np.all(np.isfinite(poles)) or np.max(poles.real) >= 0:
-                return None             # unstable: neither the FFT nor µ applies
-            peaks = [s.bumpr.peaks(K) for s in self.seats]
-            z = np.concatenate([zs / s.unit for (zs, _, _), s in zip(peaks, self.seats)])
-            u = np.concatenate([p[1] for p in peaks])
-            x1 = np.concatenate([p[2] for p in peaks])
-            if self.opts.mu_performance:
-                curve, top, _ = self.mu.peaks(K, _PEAKS)
-                rp = [curve, top, self.mu.curve(K, _resonance_points(pa))]
-            else:
-                rp = _cover_points(self.mu, K, pa)
-            if self.rs is not None:
-                rp.append(self.rs.levels(K, self.rs_scal))
-            mu = np.concatenate(rp + [g for cover, pc in covers
-                                      for g in _cover_points(cover, K, pc)])
-        b = self.bounds
-        mags = np.sort(np.abs(np.concatenate([poles, np.linalg.eigvals(K.A)])))
-        shape = _shape_margins(poles)
-        violation = max(0.0, float(np.max(u)) / b["u"] - 1, float(np.max(x1)) / b["x1"] - 1,
-                        float(np.max(mu)) / b["mu"] - 1, float(mags[-1]) / b["radius"] - 1,
-                        -float(np.min(shape)))
-        return _Point(z, u, x1, mu, mags, shape, violation)
-
-    def constraints(self, y: np.ndarray) -> np.ndarray:
-        """Normalised margins (>= 0 where met): bump peaks under the epigraph ``t``,
-        force, stroke, µ, pole magnitudes, decay."""
-        t, rest = y[0], y[1:]
-        p = self.evaluate(rest)
-        b = self.bounds
-        if p is None:
-            return -np.ones(self.size)
-        return np.concatenate([(t - p.z) / max(t, 1e-9), 1 - p.u / b["u"],
-                               1 - p.x1 / b["x1"], 1 - p.mu_curve / b["mu"],
-                               1 - p.magnitudes / b["radius"], p.shape])
-
-
-def _slsqp(z0, grad, bounds, constraints, maxiter: int):
-    """One stage's SLSQP: minimise the epigraph variable ``z[0]`` (tests replace it)."""
-    with np.errstate(all="ignore"):
-        return optimize.minimize(lambda v: v[0], z0, jac=lambda v: grad, method="SLSQP",
-                                 bounds=bounds,
-                                 constraints=[{"type": "ineq", "fun": constraints}],
-                                 options={"maxiter": maxiter, "ftol": 1e-6})
-
-
-@dataclass(frozen=True)
 class RefineStage:
     """One trust-region stage of :func:`refine_seat_controller` (progress record).
 
@@ -552,6 +343,9 @@ class RefinedDesign:
         With ``options.occupants``: the set's robust-stability µ of ``K`` over every
         frequency, with scalings optimised for ``K`` itself (``met`` judged the search's
         scalings, found for the last stage's start); nan without.
+    certificate : SystuneResult
+        ``systune``'s result: each requirement recomputed on ``K`` by another route
+        (:meth:`~.goals.SeatLoops.certified`: time simulation, ``mussv``, ``eigvals``).
     """
 
     K: control.StateSpace
@@ -567,6 +361,7 @@ class RefinedDesign:
     iterations: int
     seconds: float
     rs_sup: float = float("nan")
+    certificate: object = None
 
 
 def _seats(opts: RefineOptions, design: SeatDesignOptions, params, road) -> list:
@@ -576,14 +371,80 @@ def _seats(opts: RefineOptions, design: SeatDesignOptions, params, road) -> list
     road = bump() if road is None else road
     delays = tuple(opts.delays)
     if not opts.plants:
-        return [_Seat(BumpResponse(road=road, delays=delays, params=params), 1.0, params,
-                      None)]
+        return [SeatSeat(BumpResponse(road=road, delays=delays, params=params), 1.0, params,
+                         None)]
     seats = []
     for k, p in enumerate((params,) + opts.plants):
         limit = bump_limit(road, p, dt=_LIMIT_DT).certified_peak
-        seats.append(_Seat(BumpResponse(road=road, delays=delays, params=p), float(limit),
-                           p, None if k == 0 else TwoBlockMu(design, _MU_GRID, p)))
+        seats.append(SeatSeat(BumpResponse(road=road, delays=delays, params=p), float(limit),
+                              p, None if k == 0 else TwoBlockMu(design, _MU_GRID, p)))
     return seats
+
+
+def _refine_on_tune(start, opts: RefineOptions, design, params, road, callback, t_start):
+    """The refinement as :func:`~lmi_suspension.tune.systune`'s SLSQP route over the
+    seat's requirements (:mod:`.goals`) on the modal block
+    (:func:`~lmi_suspension.tune.tunable_modal`)."""
+    from ..tune import SystuneOptions, TrustRegionOptions, systune, tunable_modal
+    from .augmented import seat_augmented_plant
+
+    rs = None
+    if opts.occupants is not None:
+        from .occupants import MixedRsBound
+
+        rs = MixedRsBound(opts.occupants, design)
+    loops = SeatLoops(_seats(opts, design, params, road),
+                      TwoBlockMu(design, _MU_GRID, params), opts.mu_performance, rs)
+    unstable = ParameterError("K0's loop (residualised to the disk) is not stable")
+    if not loops.stable(start):
+        raise unstable      # checked here, not left to the engine, to name K0
+    block = tunable_modal("K", start, pole_bounds=(1e-3, opts.disk_radius))
+    aug = seat_augmented_plant(design, params)
+    soft = [BumpPeak(loops)]
+    hard = [BumpForce(loops, opts.u_bound), BumpStroke(loops, opts.z_bound),
+            MuBound(loops, opts.mu_max), PoleDisk(loops, opts.disk_radius), PoleShape(loops)]
+    trust = TrustRegionOptions(max_iter=opts.max_iter,
+                               stage_iter=_STAGE_ITER if rs is None else _RS_STAGE_ITER,
+                               trust_start=_TRUST_START if rs is None else _RS_TRUST_START,
+                               trust_min=_TRUST_MIN, margin=_MARGIN)
+    stages = []
+
+    def on_stage(rec):
+        f = loops.figures_at(rec.theta)
+        stage = RefineStage(index=rec.index, iterations=rec.iterations, trust=rec.trust,
+                            accepted=rec.accepted, peak=rec.soft,
+                            u_peak=float(np.max(f.u)), x1_peak=float(np.max(f.x1)),
+                            mu=float(np.max(f.mu_curve)), radius=float(f.magnitudes[-1]),
+                            violation=rec.violation, seconds=rec.seconds,
+                            rs_sup=float("nan") if rs is None else loops.rs_scal.sup)
+        stages.append(stage)
+        logger.info("refine stage %d: %s, peak %.3f m/s², |u| %.0f N, µ %.4f, radius %.0f, "
+                    "violation %.2g (%d iterations, %.1f s)", stage.index,
+                    "accepted" if stage.accepted else "rejected", stage.peak,
+                    stage.u_peak, stage.mu, stage.radius, stage.violation,
+                    stage.iterations, stage.seconds)
+        if callback is not None:
+            callback(stage)
+
+    res = systune(aug.P, block, soft=soft, hard=hard, nmeas=aug.nmeas, ncon=aug.ncon,
+                  options=SystuneOptions(method="slsqp", trust_region=trust,
+                                         on_unstable="return"),
+                  callback=on_stage)
+    if not np.isfinite(res.starts[0].soft):
+        raise unstable
+    theta = res.theta
+    best = loops.figures_at(theta)
+    K = block.ss(theta)
+    K = control.ss(K.A, K.B, K.C, K.D, inputs=["x1", "x3"], outputs=["u"], name="K_refined")
+    rs_sup = float("nan") if rs is None else loops.certified(res.K[0])["rs_sup"]
+    per_delay = (lambda v: np.max(v.reshape(len(loops.seats), -1), axis=0))
+    return RefinedDesign(K=K, K0=start, peak=per_delay(best.z), u_peak=per_delay(best.u),
+                         x1_peak=per_delay(best.x1), mu=float(np.max(best.mu_curve)),
+                         radius=float(best.magnitudes[-1]),
+                         met=res.starts[0].hard - 1.0 <= _MARGIN, options=opts,
+                         stages=tuple(stages), iterations=res.starts[0].iterations,
+                         seconds=time.perf_counter() - t_start, rs_sup=rs_sup,
+                         certificate=res)
 
 
 def refine_seat_controller(K0, options: RefineOptions | None = None, *,
@@ -594,8 +455,10 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
     delays, subject to exact force, stroke, µ and pole requirements.
 
     The controller keeps its order (after its poles outside ``options.disk_radius``
-    are residualised); its real modal realization (:func:`modal_form`) is searched by
-    SLSQP in trust-region stages (a box around the stage's start in normalised
+    are residualised); its real modal realization (:func:`modal_form`, tuned as
+    :func:`~lmi_suspension.tune.tunable_modal`) is searched by
+    :func:`~lmi_suspension.tune.systune`'s SLSQP route against the requirements of
+    :mod:`.goals`: trust-region stages (a box around the stage's start in normalised
     parameters, halved where a stage does not improve).  A stage's result is kept only
     if it is better: less violation of the requirements, or, once they are met, a lower
     peak.  Every figure is exact (see the module docstring), so the answer is a local
@@ -638,80 +501,7 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
             raise ParameterError("K0 has non-finite entries")
     start = modal_form(K0, radius=opts.disk_radius)
     design = DEFAULT_DESIGN if design is None else design
-    rs = None
-    if opts.occupants is not None:
-        from .occupants import MixedRsBound
-
-        rs = MixedRsBound(opts.occupants, design)
-    prob = _Problem(start, opts, _seats(opts, design, params, road),
-                    TwoBlockMu(design, _MU_GRID, params), rs)
-    y = prob.x0 / prob.scale
-    unstable = ParameterError("K0's loop (residualised to the disk) is not stable")
-    if rs is not None:
-        # checked here, not left to MixedRsBound.scalings, to name K0 in the error
-        if np.max(rs.loop_poles(prob.controller(y)).real) >= 0:
-            raise unstable
-        best = prob.rescale(y)
-    else:
-        best = prob.evaluate(y)
-    if best is None:
-        raise unstable
-    prob.size = prob.constraints(np.concatenate([[best.objective], y])).size
-    lower = np.full(y.size, -np.inf)
-    upper = np.full(y.size, np.inf)
-    lower[:prob.npole] = np.log(1e-3)
-    upper[:prob.npole] = np.log(opts.disk_radius)
-    trust, iterations, stages = (_TRUST_START if rs is None else _RS_TRUST_START), 0, []
-    stage_iter = _STAGE_ITER if rs is None else _RS_STAGE_ITER
-    while iterations < opts.max_iter and trust >= _TRUST_MIN:
-        t0 = time.perf_counter()
-        if rs is not None and stages and stages[-1].accepted:
-            # the D-step of the alternation: scalings for the stage's start (after a
-            # rejected stage the start, and so its scalings, are the same).  The start's
-            # figures may rise with them: new split points can hold a peak the last missed
-            best = prob.rescale(y)
-            logger.info("refine stage %d: the set's robust-stability µ %.4f over every "
-                        "frequency at its start", len(stages) + 1, prob.rs_scal.sup)
-        # the epigraph variable t first: minimise t with every peak below it
-        z0 = np.concatenate([[best.objective], y])
-        lo = np.concatenate([[0.0], np.maximum(lower, y - trust)])
-        hi = np.concatenate([[np.inf], np.minimum(upper, y + trust)])
-        grad = np.zeros(z0.size)
-        grad[0] = 1.0
-        res = _slsqp(z0, grad, list(zip(lo, hi)), prob.constraints,
-                     min(stage_iter, opts.max_iter - iterations))
-        iterations += int(res.nit)
-        prob.evaluate(np.clip(res.x[1:], np.maximum(lower, y - trust),
-                              np.minimum(upper, y + trust)))
-        accepted = prob.best is not best
-        if accepted:
-            y, best = prob.best_y, prob.best
-        else:
-            trust /= 2
-        rec = RefineStage(index=len(stages) + 1, iterations=int(res.nit), trust=trust,
-                          accepted=accepted, peak=best.objective,
-                          u_peak=float(np.max(best.u)), x1_peak=float(np.max(best.x1)),
-                          mu=best.mu, radius=best.radius, violation=best.violation,
-                          seconds=time.perf_counter() - t0,
-                          rs_sup=float("nan") if rs is None else prob.rs_scal.sup)
-        stages.append(rec)
-        logger.info("refine stage %d: %s, peak %.3f m/s², |u| %.0f N, µ %.4f, radius %.0f, "
-                    "violation %.2g (%d iterations, %.1f s)", rec.index,
-                    "accepted" if accepted else "rejected", rec.peak, rec.u_peak, rec.mu,
-                    rec.radius, rec.violation, rec.iterations, rec.seconds)
-        if callback is not None:
-            callback(rec)
-        if accepted and best.violation <= _MARGIN and res.success and res.nit < stage_iter:
-            break        # SLSQP converged inside the box: a local optimum
-    K = prob.controller(y)
-    K = control.ss(K.A, K.B, K.C, K.D, inputs=["x1", "x3"], outputs=["u"], name="K_refined")
-    rs_sup = float("nan") if rs is None else rs.scalings(K).sup
-    per_delay = (lambda v: np.max(v.reshape(len(prob.seats), -1), axis=0))
-    return RefinedDesign(K=K, K0=start, peak=per_delay(best.z), u_peak=per_delay(best.u),
-                         x1_peak=per_delay(best.x1),
-                         mu=best.mu, radius=best.radius, met=best.violation <= _MARGIN,
-                         options=opts, stages=tuple(stages), iterations=iterations,
-                         seconds=time.perf_counter() - t_start, rs_sup=rs_sup)
+    return _refine_on_tune(start, opts, design, params, road, callback, t_start)
 
 
 # ----------------------------------------------------------------------------- certificate
