@@ -1073,8 +1073,9 @@ def test_trust_region_slsqp_solves_a_smooth_minimax_with_a_bound():
 def test_systune_slsqp_route_meets_the_tightened_hard_bound():
     """The guide's GainAt (soft, |T_00(j0)| = 1/(1 - k)) under the hard pole region
     |p| ≤ 3 by the SLSQP route: requirements without ``terms``/``margins`` count as their
-    value, the hard one aimed at 3 (1 - 2 margin), so k = 1 - 3 (1 - 2 margin) and the
-    value 1/(3 (1 - 2 margin)) (closed form, as for the BFGS route's k = -2, 1/3)."""
+    value, the hard one (value 1 + (|p| - 3)/scale, scale 1) aimed at 1 - 2 margin, so
+    |p| = 1 - k = 3 - 2 margin and the soft value 1/(3 - 2 margin) (closed form, as for
+    the BFGS route's k = -2, 1/3)."""
     from lmi_suspension.tune import TrustRegionOptions
 
     tr = TrustRegionOptions(max_iter=40, stage_iter=20, margin=1e-4)
@@ -1083,8 +1084,10 @@ def test_systune_slsqp_route_meets_the_tightened_hard_bound():
                   hard=PoleRegion(max_frequency=3.0),
                   options=SystuneOptions(method="slsqp", trust_region=tr), callback=seen.append)
     assert res.feasible and res.stages and seen == list(res.stages)
-    assert res.values["K.k"] == pytest.approx(1 - 3 * tr.tighten, rel=1e-5)
-    assert res.soft == pytest.approx(1 / (3 * tr.tighten), rel=1e-5)
+    radius = 3.0 + (tr.tighten - 1.0)
+    assert res.values["K.k"] == pytest.approx(1 - radius, rel=1e-6)
+    assert res.soft == pytest.approx(1 / radius, rel=1e-6)
+    assert res.hard_values[0, 0] <= 1.0
     assert res.soft_values[0, 0] == pytest.approx(
         abs(complex(control.evalfr(res.CL[0][0, 0], 0j))), rel=1e-12)
     with pytest.raises(ParameterError, match="method"):

@@ -19,7 +19,9 @@ Two guards make it reliable on such problems (both measured on the seat, 2026-11
 * a **trust region**: each stage of at most ``stage_iter`` SLSQP iterations is confined
   to a box of half-width ``trust`` around its start (plain SLSQP wandered to µ 2.3 and
   back); a stage's end is kept only if it is *better* -- less violation of the hard
-  terms, or, once they are met, a lower soft maximum -- else the box is halved;
+  terms, or, once they are met, a lower soft maximum -- else the box is halved; the
+  search ends when a kept stage converged (SLSQP's success, fewer iterations than the
+  stage allows, the hard terms met) strictly inside its box;
 * the **best evaluated point**, not the last: every evaluation (SLSQP's iterates and
   its difference probes alike) is a parameter vector with exact figures, and the best
   one is kept.
@@ -46,6 +48,11 @@ from ..errors import ParameterError
 __all__ = ["TrustRegionOptions", "TrustRegionStage", "trust_region_slsqp"]
 
 logger = logging.getLogger(__name__)
+
+#: an end point within this fraction of the trust radius of the box's edge is on it
+#: (SLSQP ends on an active bound to round-off; a stage that ends there has not converged
+#: but met the box: a smooth minimax test stopped at its first box, 2026-12-02)
+_BOX_EDGE = 1e-6
 
 
 @dataclass(frozen=True)
@@ -240,7 +247,13 @@ def trust_region_slsqp(evaluate, theta0, options: TrustRegionOptions | None = No
                      search.constraints, min(opts.stage_iter, opts.max_iter - iterations),
                      opts.ftol)
         iterations += int(res.nit)
-        search.evaluate(np.clip(res.x[1:], box_lo, box_hi))
+        end = np.clip(res.x[1:], box_lo, box_hi)
+        search.evaluate(end)
+        # on the box's edge where the box is tighter than the bounds: stopped by the trust
+        # region, not at a local optimum
+        edge = _BOX_EDGE * trust
+        on_edge = bool(np.any((end <= box_lo + edge) & (box_lo > lower))
+                       or np.any((end >= box_hi - edge) & (box_hi < upper)))
         accepted = search.best is not best
         if accepted:
             y, best = search.best_y, search.best
@@ -257,6 +270,6 @@ def trust_region_slsqp(evaluate, theta0, options: TrustRegionOptions | None = No
         if callback is not None:
             callback(rec)
         if accepted and best.violation <= opts.margin and res.success \
-                and res.nit < opts.stage_iter:
+                and res.nit < opts.stage_iter and not on_edge:
             break        # SLSQP converged inside the box: a local optimum
     return y, best.objective, best.violation, tuple(stages), iterations
