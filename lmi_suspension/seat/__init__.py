@@ -9,7 +9,8 @@ a worst-case search), :mod:`.bounded` (H∞ with peak bounds) and :mod:`.sampled
 1 kHz implementation); :mod:`.occupants` is the set of seats a controller must serve and
 its certificate over them, :mod:`.worstcase` the search for its worst seats.
 :mod:`.loop` holds the loop's closed-form bump response, poles and two-block µ that
-these use; :mod:`.record` the one result type (:class:`SeatDesign`) and the certificate
+these use, :mod:`.goals` the refinement's requirements as classes of
+:mod:`lmi_suspension.tune`'s protocol; :mod:`.record` the one result type (:class:`SeatDesign`) and the certificate
 (:func:`certify_seat`) below every route; :mod:`.routes`, on top, the one entry to them
 all (:func:`design_seat`).
 """
@@ -29,8 +30,8 @@ from .bounded import PeakBoundedDesign, design_peak_bounded
 # the designs' own modules, documented as modules: the µ design, its constrained K-step
 # route, the refinement (on one seat and on a set), the set of seats and its certificate,
 # and the sampled-data implementation
-from . import (constrained, design, loop, multimodel, mucheck, occupants, record, refine,
-               routes, sampled, worstcase)
+from . import (constrained, design, goals, loop, multimodel, mucheck, occupants, record,
+               refine, routes, sampled, worstcase)
 # the one result type and the certificate, below every route
 from .record import SeatCertificate, SeatDesign, SeatRequirements, certify_seat
 # one entry for every route: design_seat
@@ -49,7 +50,7 @@ __all__ = [
     "LimitResult", "bump_limit",
     "PeakBoundedDesign", "design_peak_bounded", "road_energy",
     "design", "constrained", "refine", "multimodel", "occupants", "sampled", "worstcase",
-    "loop", "mucheck", "record",
+    "goals", "loop", "mucheck", "record",
     "SeatRoute", "SeatDesign", "SeatRequirements", "SeatCertificate", "design_seat",
     "certify_seat", "save_seat_design", "load_seat_design", "routes",
 ]
