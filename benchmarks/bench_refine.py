@@ -12,9 +12,10 @@ import pytest
 
 from lmi_suspension.lti import freqresp, lft
 from lmi_suspension.mu import mussv
-from lmi_suspension.seat.augmented import seat_augmented_plant
-from lmi_suspension.seat.design import DEFAULT_DESIGN, design_mu_controller
-from lmi_suspension.seat.refine import _MU_GRID, REFINE_DELAYS, BumpResponse, TwoBlockMu
+from lmi_suspension.seat.augmented import DEFAULT_DESIGN, seat_augmented_plant
+from lmi_suspension.seat.design import design_mu_controller
+from lmi_suspension.seat.loop import REFINE_DELAYS, BumpResponse, TwoBlockMu
+from lmi_suspension.seat.refine import _MU_GRID
 from lmi_suspension.seat.roads import bump
 from lmi_suspension.seat.simulate import simulate
 

@@ -14,8 +14,8 @@ import numpy as np
 
 from lmi_suspension.examples import stiffness_oscillator
 from lmi_suspension.mu import MusynOptions, musyn
-from lmi_suspension.seat.augmented import seat_augmented_plant
-from lmi_suspension.seat.design import DEFAULT_DESIGN, DEFAULT_OMEGA
+from lmi_suspension.seat.augmented import DEFAULT_DESIGN, seat_augmented_plant
+from lmi_suspension.seat.design import DEFAULT_OMEGA
 
 if __name__ == "__main__":
     warnings.filterwarnings("ignore")

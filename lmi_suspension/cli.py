@@ -176,7 +176,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def _write_certificate(c, out=None) -> None:
-    """A seat certificate (:func:`~lmi_suspension.seat.routes.certify_seat`) as text: the
+    """A seat certificate (:func:`~lmi_suspension.seat.record.certify_seat`) as text: the
     bump per delay first, then µ, poles, the delay margin and the requirements."""
     out = sys.stdout if out is None else out
     out.write(f"{'delay [ms]':>10} {'z3dd peak':>10} {'/limit':>7} {'u cmd [N]':>10} "
@@ -274,7 +274,7 @@ def _cmd_occupants(args: argparse.Namespace) -> int:
     from .io import load_controller
     from .report.figures import plot_occupants
     from .seat.occupants import occupant_samples
-    from .seat.routes import certify_seat
+    from .seat.record import certify_seat
 
     controllers = {Path(c).stem: load_controller(c)[0] for c in args.controllers}
     if len(controllers) != len(args.controllers):

@@ -142,7 +142,8 @@ except ImportError:
 
 stored = None   # µ bounds that came with the design, to be checked below
 if seat_design is not None:
-    design_options = seat_design.DEFAULT_DESIGN
+    from lmi_suspension.seat.augmented import DEFAULT_DESIGN
+    design_options = DEFAULT_DESIGN
     if saved.exists():
         from lmi_suspension.io import load_controller
         K, meta = load_controller(saved)

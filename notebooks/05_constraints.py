@@ -33,7 +33,8 @@ from IPython.display import display
 
 from lmi_suspension.report.figures import plot_bounded_response, plot_force_tradeoff
 from lmi_suspension.seat import bump, bump_limit, simulate
-from lmi_suspension.seat.bounded import design_peak_bounded, road_energy, seat_peak_plant
+from lmi_suspension.seat.bounded import design_peak_bounded, seat_peak_plant
+from lmi_suspension.seat.roads import road_energy
 from lmi_suspension.synthesis import msyn
 from lmi_suspension.synthesis.constraints import Channel, HinfBound
 

@@ -209,7 +209,7 @@ def test_occupants_certifies_and_draws_each_controller(capsys, tmp_path):
         assert any(f.startswith("set: worst peak / own limit")
                    for f in row["requirements_not_met"]) == (c.worst_ratio > 1.5)
     # the set's worst force and stroke by search, on the certificate's third stream
-    from lmi_suspension.seat.routes import SeatRequirements
+    from lmi_suspension.seat.record import SeatRequirements
     from lmi_suspension.seat.worstcase import worst_bump_seats
 
     u, x1 = worst_bump_seats(load_refined()[0], rng=np.random.default_rng(4).spawn(3)[2])

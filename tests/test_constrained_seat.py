@@ -15,8 +15,8 @@ import pytest
 
 from lmi_suspension.errors import InfeasibleError, ParameterError
 from lmi_suspension.seat.constrained import (CONSTRAINED_MUSYN, SHIPPED_CONTROLLER,
-                                             certify_constrained, design_constrained_mu,
-                                             load_constrained)
+                                             design_constrained_mu, load_constrained)
+from lmi_suspension.seat.mucheck import certify_constrained
 from lmi_suspension.seat.roads import bump
 from lmi_suspension.seat.sampled import simulate_sampled
 from lmi_suspension.seat.simulate import closed_loop_stable, simulate

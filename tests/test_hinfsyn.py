@@ -101,8 +101,7 @@ def _nominal_seat_plant():
     with the comfort weights of the 2026-11-22 design, pinned (see the polish test)."""
     from dataclasses import replace
 
-    from lmi_suspension.seat.augmented import seat_augmented_plant
-    from lmi_suspension.seat.design import DEFAULT_DESIGN
+    from lmi_suspension.seat.augmented import DEFAULT_DESIGN, seat_augmented_plant
 
     weights = replace(DEFAULT_DESIGN, acc_ref=3.0, u_max=3000.0, z_max=0.10,
                       noise=(5e-4, 5e-4), w_scale=0.65, w_corner=6.5, w_rolloff=None)

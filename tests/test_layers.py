@@ -141,3 +141,43 @@ def test_no_import_runs_up_a_floor(graph):
                     for t in targets
                     if _floor(t) is None or _floor(t) > _floor(m))
     assert upward == []
+
+
+#: the seat package's floors, lowest first (the architecture notes): the seat itself (no
+#: design code); the loop's closed forms, the µ check and the set of seats with its worst
+#: case; the result module (SeatDesign, certify_seat); one module per route; the table of
+#: routes on top.  A module of the seat not named here fails the test below: place it.
+SEAT_FLOORS = (
+    ("params", "model", "roads", "comfort", "weights", "simulate", "limit", "uncertainty",
+     "augmented", "sampled"),
+    ("loop", "goals", "mucheck", "occupants", "worstcase"),
+    ("record",),
+    ("design", "constrained", "bounded", "discrete_design", "refine", "multimodel"),
+    ("routes",),
+)
+
+
+def _seat_floor(module: str) -> int | None:
+    short = module.removeprefix("lmi_suspension.seat.")
+    return next((i for i, f in enumerate(SEAT_FLOORS) if short in f), None)
+
+
+def test_no_cycle_in_the_seat(graph):
+    """The seat's modules import no circle (``routes`` imported every route and every
+    route took ``seat_design_from`` from ``routes``: nine modules in one circle until
+    the result type and the loop's closed forms moved below the routes)."""
+    seat = {m for m in graph if m.startswith("lmi_suspension.seat.")}
+    assert len(seat) > 15
+    assert _cycles(graph, seat) == []
+
+
+def test_the_seat_floors(graph):
+    """Every seat module has a floor and imports only its floor and those below; no seat
+    module imports ``routes`` (only the package's face and the layers above the seat
+    do)."""
+    seat = sorted(m for m in graph if m.startswith("lmi_suspension.seat."))
+    assert [m for m in seat if _seat_floor(m) is None] == []
+    upward = sorted((m, t) for m in seat for t in graph[m]
+                    if t.startswith("lmi_suspension.seat.") and _seat_floor(t) > _seat_floor(m))
+    assert upward == []
+    assert [m for m in seat if "lmi_suspension.seat.routes" in graph[m]] == []

@@ -13,7 +13,8 @@ from lmi_suspension.seat import refine
 from lmi_suspension.seat.limit import bump_limit
 from lmi_suspension.seat.multimodel import refine_for_occupants
 from lmi_suspension.seat.occupants import OccupantSet
-from lmi_suspension.seat.refine import BumpResponse, RefineOptions, load_refined, loop_poles
+from lmi_suspension.seat.loop import BumpResponse, loop_poles
+from lmi_suspension.seat.refine import RefineOptions, load_refined
 from lmi_suspension.seat.roads import bump
 
 

@@ -20,11 +20,12 @@ from lmi_suspension.mu import mussv
 from lmi_suspension.seat.augmented import seat_augmented_plant
 from lmi_suspension.seat.design import design_mu_controller
 from lmi_suspension.seat.limit import bump_limit
-from lmi_suspension.seat.design import DEFAULT_DESIGN
+from lmi_suspension.seat.augmented import DEFAULT_DESIGN
 from lmi_suspension.seat.occupants import (MixedRsBound, OccupantSamples, OccupantSet,
                                            certify_occupants, occupant_mu, occupant_samples)
 from lmi_suspension.seat.params import SeatParameters
-from lmi_suspension.seat.refine import TwoBlockMu, load_refined, loop_poles
+from lmi_suspension.seat.loop import TwoBlockMu, loop_poles
+from lmi_suspension.seat.refine import load_refined
 from lmi_suspension.seat.roads import bump
 from lmi_suspension.seat.simulate import simulate
 

@@ -13,16 +13,23 @@ import numpy as np
 import pytest
 
 from lmi_suspension.errors import DimensionError, ParameterError
-from lmi_suspension.lti import freqresp, lft
+from lmi_suspension.lti import GeneralizedPlant, freqresp, lft
 from lmi_suspension.mu import mussv
 from lmi_suspension.seat import refine
-from lmi_suspension.seat.augmented import seat_augmented_plant
-from lmi_suspension.seat.design import DEFAULT_DESIGN, design_mu_controller
-from lmi_suspension.seat.refine import (REFINE_DELAYS, SHIPPED_REFINED, BumpResponse,
-                                        RefineOptions, TwoBlockMu, certify_refined,
-                                        load_refined, modal_form, refine_seat_controller)
+from lmi_suspension.seat.augmented import DEFAULT_DESIGN, seat_augmented_plant
+from lmi_suspension.seat.design import design_mu_controller
+from lmi_suspension.seat.loop import REFINE_DELAYS, BumpResponse, TwoBlockMu
+from lmi_suspension.seat.refine import (
+    SHIPPED_REFINED,
+    RefineOptions,
+    certify_refined,
+    load_refined,
+    modal_form,
+    refine_seat_controller,
+)
 from lmi_suspension.seat.roads import bump
 from lmi_suspension.seat.simulate import simulate
+from lmi_suspension.tune import stages
 
 
 @pytest.fixture(scope="module")
@@ -132,16 +139,17 @@ def test_bad_options_raise(field, value):
 
 
 def test_a_worse_stage_is_rejected_and_the_box_halved(K_mu, monkeypatch):
-    """Injected: SLSQP returns a point far outside the requirements; the stage must be
-    rejected, the trust box halved, and the start kept."""
+    """Injected: SLSQP (of the engine's SLSQP route, lmi_suspension.tune.stages) returns
+    a point far outside the requirements; the stage must be rejected, the trust box
+    halved, and the start kept."""
     from types import SimpleNamespace
 
-    def bad_slsqp(z0, grad, bounds, constraints, maxiter):
+    def bad_slsqp(z0, grad, bounds, constraints, maxiter, ftol):
         x = np.array(z0, dtype=float)
         x[1 + 20:] *= 3.0                      # gains tripled
         return SimpleNamespace(x=x, nit=1, success=False)
 
-    monkeypatch.setattr(refine, "_slsqp", bad_slsqp)
+    monkeypatch.setattr(stages, "_slsqp", bad_slsqp)
     d = refine_seat_controller(K_mu, RefineOptions(max_iter=2))
     assert [s.accepted for s in d.stages] == [False, False]
     assert [s.trust for s in d.stages] == [refine._TRUST_START / 2, refine._TRUST_START / 4]
@@ -163,10 +171,10 @@ def test_the_sets_robust_stability_enters_every_stage(monkeypatch):
 
     from lmi_suspension.seat.occupants import MixedRsBound, OccupantSet
 
-    def still(z0, grad, bounds, constraints, maxiter):
+    def still(z0, grad, bounds, constraints, maxiter, ftol):
         return SimpleNamespace(x=np.array(z0, dtype=float), nit=1, success=False)
 
-    monkeypatch.setattr(refine, "_slsqp", still)
+    monkeypatch.setattr(stages, "_slsqp", still)
     s = OccupantSet()
     K0 = load_refined(Path(__file__).parent / "data" / "multiseat_v1.json")[0]
     d = refine_seat_controller(K0, RefineOptions(max_iter=2, mu_performance=False,
@@ -370,7 +378,7 @@ def test_interconnection_poles_are_the_lfts_and_refuse_a_nonzero_d22():
     """The poles formula (D22 = 0) against the closed loop built by ``lti.lft``; with
     D22 ≠ 0 the formula would be wrong, so it refuses."""
     from lmi_suspension.errors import InputError
-    from lmi_suspension.seat.refine import interconnection_poles
+    from lmi_suspension.seat.loop import interconnection_poles
 
     rng = np.random.default_rng(4)
     nw, nu, nz, ny, n, nk = 2, 1, 2, 2, 5, 3
@@ -388,3 +396,46 @@ def test_interconnection_poles_are_the_lfts_and_refuse_a_nonzero_d22():
     P22 = control.ss(P.A, P.B, P.C, D)
     with pytest.raises(InputError, match="D22"):
         interconnection_poles(P22, K, nw, nu, nz, ny)
+
+
+def test_the_seat_requirements_certify_their_search_figures():
+    """The seat's requirement classes (seat/goals.py) on the shipped refined controller:
+    each search figure (FFT bump response, two-block µ formula at the grid and its refined
+    peaks, pole formulas) against its certificate by another route (time-stepping
+    simulation; mussv on the grid and at the peaks' frequencies; eigvals of lft), within
+    the tolerances the tests above state for those pairs: 3e-3 for the bump (FFT against
+    simulation), 1e-6 for µ (two-block formula against mussv's upper bound), 1e-9 for
+    the poles."""
+    from lmi_suspension.seat.goals import (
+        BumpForce,
+        BumpPeak,
+        BumpStroke,
+        MuBound,
+        PoleDisk,
+        PoleShape,
+        SeatLoops,
+        SeatSeat,
+    )
+    from lmi_suspension.tune import ClosedLoop, tunable_modal
+
+    K = modal_form(load_refined()[0], 1900.0)
+    # the two ends of the delay range (two time simulations keep the test short)
+    loops = SeatLoops([SeatSeat(BumpResponse(delays=(0.0, 0.025)), 1.0, None, None)],
+                      TwoBlockMu(DEFAULT_DESIGN, refine._MU_GRID))
+    block = tunable_modal("K", K, pole_bounds=(1e-3, 1900.0))
+    aug = seat_augmented_plant(DEFAULT_DESIGN)
+    loop = ClosedLoop.from_blocks(aug.P, block, block.start, aug.nmeas, aug.ncon)
+    CL = lft(aug.P, K, aug.nmeas, aug.ncon)
+    reqs = [BumpPeak(loops), BumpForce(loops, 1500.0), BumpStroke(loops, 0.08),
+            MuBound(loops, 0.98), PoleDisk(loops, 1900.0), PoleShape(loops)]
+    got = [r.bind(loop.plant)._value(loop) for r in reqs]
+    cert = [r.certify(CL, loop.plant, K) for r in reqs]
+    assert got[:3] == pytest.approx(cert[:3], rel=3e-3)
+    assert got[3] == pytest.approx(cert[3], rel=1e-6)
+    assert got[4:] == pytest.approx(cert[4:], rel=1e-9)
+    # the shipped design meets them all (its search figures: 8.849 / 8.848 m/s² at 0 / 25
+    # ms, 1495 N, µ 0.974: seat/data/mu_refined.json)
+    assert max(cert[1:]) <= 1.0 and got[0] == pytest.approx(8.85, abs=0.01)
+    with pytest.raises(DimensionError, match="two measurements"):
+        BumpPeak(loops).bind(GeneralizedPlant.from_matrices(
+            A=[[-1.0]], B1=[[1.0]], B2=[[1.0]], C1=[[1.0]], C2=[[1.0]]))

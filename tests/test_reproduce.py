@@ -19,10 +19,11 @@ from matplotlib.image import imread
 from lmi_suspension.errors import AssumptionError, ParameterError
 from lmi_suspension.io import load_controller
 from lmi_suspension.mu.dk import MusynIteration
-from lmi_suspension.seat.constrained import CONSTRAINED_DESIGN, ConstrainedCheck
+from lmi_suspension.seat.augmented import CONSTRAINED_DESIGN
+from lmi_suspension.seat.mucheck import ConstrainedCheck
 from lmi_suspension.seat.design import MuCheck, SeatMuDesign, _dk_line
 from lmi_suspension.seat.occupants import OccupantSet
-from lmi_suspension.seat.routes import SeatCertificate, seat_design_from
+from lmi_suspension.seat.record import SeatCertificate, seat_design_from
 from lmi_suspension.seat.sampled import discretise_controller, simulate_sampled
 from lmi_suspension.sweep import read_results
 from lmi_suspension.seat import (

@@ -18,16 +18,18 @@ from lmi_suspension.io import load_controller, save_controller
 from lmi_suspension.seat import (SeatParameters, bump, bump_limit, closed_loop_stable,
                                  seat_matrices, simulate)
 from lmi_suspension.seat.bounded import PeakBoundedRoute, design_peak_bounded
-from lmi_suspension.seat.constrained import CONSTRAINED_DESIGN, ConstrainedRoute
-from lmi_suspension.seat.design import DEFAULT_DESIGN, MuRoute
+from lmi_suspension.seat.augmented import CONSTRAINED_DESIGN, DEFAULT_DESIGN
+from lmi_suspension.seat.constrained import ConstrainedRoute
+from lmi_suspension.seat.design import MuRoute
 from lmi_suspension.seat.multimodel import OccupantRoute
 from lmi_suspension.seat.occupants import OccupantSet, occupant_samples
-from lmi_suspension.seat.refine import RefineRoute, _LIMIT_DT, certify_refined
+from lmi_suspension.seat.loop import _LIMIT_DT, REFINE_DELAYS
+from lmi_suspension.seat.refine import RefineRoute, certify_refined
 from lmi_suspension.seat.discrete_design import DiscreteMuRoute
-from lmi_suspension.seat.routes import (ROUTE_NAMES, SHIPPED_DESIGNS, SeatCertificate,
-                                        SeatDesign, SeatRequirements, SeatRoute,
-                                        certify_seat, design_seat, load_seat_design,
-                                        route_named, save_seat_design, seat_design_from)
+from lmi_suspension.seat.record import (SeatCertificate, SeatDesign, SeatRequirements,
+                                        certify_seat, seat_design_from)
+from lmi_suspension.seat.routes import (ROUTE_NAMES, SHIPPED_DESIGNS, SeatRoute, design_seat,
+                                        load_seat_design, route_named, save_seat_design)
 from lmi_suspension.seat.sampled import discretise_controller
 from lmi_suspension.seat.worstcase import worst_bump_seats
 
@@ -201,8 +203,6 @@ def test_the_passive_seat_is_judged_against_the_requirements():
 
 @pytest.mark.slow  # 16 s on Zen 1 (2026-12-02): the second tier
 def test_certify_refined_is_the_one_certificate_with_the_refinements_delays():
-    from lmi_suspension.seat.refine import REFINE_DELAYS
-
     K = control.ss([[-200.0]], [[200.0, 0.0]], [[15000.0]], [[0.0, 2000.0]])
     a = certify_refined(K, rng=np.random.default_rng(0))
     b = certify_seat(K, delays=REFINE_DELAYS, rng=np.random.default_rng(0))

@@ -225,7 +225,8 @@ def test_seat_state_feedback_with_hard_force_and_stroke_bounds():
     by a time simulation of the linear loop built here.  Measured 2026-11-25: H∞ 23.08
     without bounds (its worst road needs 6211 N), 27.65 at 1500 N / 0.08 m (output
     feedback through x1, x3: 28.6)."""
-    from lmi_suspension.seat.bounded import RHO_U, U, X1, Z3DD, road_energy, seat_peak_plant
+    from lmi_suspension.seat.bounded import RHO_U, U, X1, Z3DD, seat_peak_plant
+    from lmi_suspension.seat.roads import road_energy
     from lmi_suspension.seat.roads import bump
 
     b = seat_peak_plant().blocks()

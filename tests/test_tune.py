@@ -1037,3 +1037,89 @@ def test_static_output_feedback_on_compleib_ac4_against_a_grid():
     box = [(v - max(2 * abs(v), 2.0), v + max(2 * abs(v), 2.0)) for v in res.theta]
     ref, point, _ = _static_grid(P, box)
     assert abs(res.gamma / ref - 1) < 0.01, (res.gamma, ref, point)
+
+
+# --------------------------------------------------------------------------- SLSQP route
+def test_trust_region_slsqp_solves_a_smooth_minimax_with_a_bound():
+    """min over x of max((x0 - 1)² + x1², (x0 + 1)² + x1²) subject to x0 ≥ 0.5: the
+    unconstrained minimax is at x = 0 (value 1); with the bound the optimum is
+    x = (0.5, 0), value max(0.25, 2.25) = 2.25 (closed form).  The bound is the margin
+    ``(x0 - 0.5 / tighten) / 1`` of a hard bound tightened by ``1 - 2 margin``, so the
+    search ends at x0 = 0.5 / tighten."""
+    from lmi_suspension.tune import TrustRegionOptions, trust_region_slsqp
+
+    opts = TrustRegionOptions(max_iter=60, stage_iter=20, margin=1e-4)
+    refreshed = []
+
+    def evaluate(x):
+        soft = np.array([(x[0] - 1) ** 2 + x[1] ** 2, (x[0] + 1) ** 2 + x[1] ** 2])
+        return soft, np.array([x[0] - 0.5 / opts.tighten])
+
+    x, soft, violation, stages, it = trust_region_slsqp(
+        evaluate, [2.0, 1.0], opts, lower=[-5.0, -5.0], upper=[5.0, 5.0],
+        refresh=refreshed.append)
+    x0 = 0.5 / opts.tighten
+    assert x == pytest.approx([x0, 0.0], abs=1e-5)
+    assert soft == pytest.approx((x0 + 1) ** 2, rel=1e-6) and violation <= opts.margin
+    assert 1 <= it <= 60 and stages[-1].theta == pytest.approx(x)
+    # refreshed at the start and at each accepted stage's start after the first
+    assert len(refreshed) == 1 + sum(s.accepted for s in stages[:-1])
+    with pytest.raises(ParameterError, match="undefined at the start"):
+        trust_region_slsqp(lambda x: None, [0.0], opts)
+    with pytest.raises(ParameterError, match="margin"):
+        TrustRegionOptions(margin=0.7)
+
+
+def test_systune_slsqp_route_meets_the_tightened_hard_bound():
+    """The guide's GainAt (soft, |T_00(j0)| = 1/(1 - k)) under the hard pole region
+    |p| ≤ 3 by the SLSQP route: requirements without ``terms``/``margins`` count as their
+    value, the hard one (value 1 + (|p| - 3)/scale, scale 1) aimed at 1 - 2 margin, so
+    |p| = 1 - k = 3 - 2 margin and the soft value 1/(3 - 2 margin) (closed form, as for
+    the BFGS route's k = -2, 1/3)."""
+    from lmi_suspension.tune import TrustRegionOptions
+
+    tr = TrustRegionOptions(max_iter=40, stage_iter=20, margin=1e-4)
+    seen = []
+    res = systune(gain_plant(1.0), tunable_gain("K", 1, 1), soft=GainAt(0.0, 1.0),
+                  hard=PoleRegion(max_frequency=3.0),
+                  options=SystuneOptions(method="slsqp", trust_region=tr), callback=seen.append)
+    assert res.feasible and res.stages and seen == list(res.stages)
+    radius = 3.0 + (tr.tighten - 1.0)
+    assert res.values["K.k"] == pytest.approx(1 - radius, rel=1e-6)
+    assert res.soft == pytest.approx(1 / radius, rel=1e-6)
+    assert res.hard_values[0, 0] <= 1.0
+    assert res.soft_values[0, 0] == pytest.approx(
+        abs(complex(control.evalfr(res.CL[0][0, 0], 0j))), rel=1e-12)
+    with pytest.raises(ParameterError, match="method"):
+        SystuneOptions(method="newton")
+
+
+def test_tunable_modal_stays_stable_and_its_jacobian_is_the_derivative():
+    """Any parameters give a stable A with the start's pattern; the Jacobian of
+    [[D, C], [B, A]] against central differences (step 1e-6: error ~1e-10)."""
+    from lmi_suspension.tune import tunable_modal
+
+    K0 = control.ss([[-1.0, 2.0, 0.0], [-2.0, -1.0, 0.0], [0.0, 0.0, -5.0]],
+                    [[1.0, 0.0], [0.5, 2.0], [0.0, 1.0]], [[3.0, 0.0, -1.0]], [[0.0, 0.1]])
+    K = tunable_modal("K", K0, pole_bounds=(1e-3, 100.0))
+    assert K.n_poles == 3 and K.n_params == 3 + 6 + 3 + 2
+    assert K.upper[:3] == pytest.approx(np.log(100.0)) and np.all(np.isinf(K.upper[3:]))
+    np.testing.assert_allclose(K.ss(K.start).B, K0.B, rtol=1e-15)
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        theta = K.start + rng.normal(0, 2.0, K.n_params)
+        A = K.matrices(theta)[0]
+        assert np.max(np.linalg.eigvals(A).real) < 0
+        J = K.jacobian(theta)
+
+        def stacked(t):
+            A, B, C, D = K.matrices(t)
+            return np.block([[D, C], [B, A]])
+
+        for i in range(K.n_params):
+            e = np.zeros(K.n_params)
+            e[i] = 1e-6
+            fd = (stacked(theta + e) - stacked(theta - e)) / 2e-6
+            np.testing.assert_allclose(J[i], fd, atol=1e-6 * max(1.0, np.max(np.abs(fd))))
+    with pytest.raises(ParameterError, match="modal"):
+        tunable_modal("K", control.ss([[1.0]], [[1.0]], [[1.0]], [[0.0]]))

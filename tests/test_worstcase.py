@@ -17,9 +17,10 @@ import numpy as np
 import pytest
 
 from lmi_suspension.errors import ParameterError
+from lmi_suspension.seat.loop import BumpResponse, loop_poles
 from lmi_suspension.seat.occupants import OccupantSet
 from lmi_suspension.seat.params import SeatParameters
-from lmi_suspension.seat.refine import BumpResponse, load_refined, loop_poles
+from lmi_suspension.seat.refine import load_refined
 from lmi_suspension.seat.roads import bump
 from lmi_suspension.seat.simulate import simulate
 from lmi_suspension.seat.worstcase import WorstSeat, worst_bump_seats
@@ -99,7 +100,7 @@ def test_an_instability_at_the_longer_delays_names_the_first_unstable_delay():
     seat with soft c1 only up to 20 ms (the delay margin, computed here by its own
     routine).  The search reports inf at the first delay where its seat's loop is
     unstable, the one before it stable."""
-    from lmi_suspension.seat.refine import REFINE_DELAYS
+    from lmi_suspension.seat.loop import REFINE_DELAYS
     from lmi_suspension.seat.simulate import closed_loop_stable, stability_delay_margin
 
     stiff = control.ss([], [], [], [[60000.0, 0.0]])
@@ -174,7 +175,7 @@ def test_the_climb_reaches_an_interior_maximum_of_constructed_figures(monkeypatc
     import importlib
     from types import SimpleNamespace
 
-    refine = importlib.import_module("lmi_suspension.seat.refine")
+    loop = importlib.import_module("lmi_suspension.seat.loop")
     simulation = importlib.import_module("lmi_suspension.seat.simulate")
     occ = OccupantSet()
     _, lo, hi = occ.ranges()[1]
@@ -198,8 +199,8 @@ def test_the_climb_reaches_an_interior_maximum_of_constructed_figures(monkeypatc
         figures = SimpleNamespace(peak_u_command=force(params), peak_x1=stroke(params))
         return SimpleNamespace(metrics=lambda: figures)
 
-    monkeypatch.setattr(refine, "BumpResponse", Response)
-    monkeypatch.setattr(refine, "loop_poles", lambda K, p: np.array([-1.0]))
+    monkeypatch.setattr(loop, "BumpResponse", Response)
+    monkeypatch.setattr(loop, "loop_poles", lambda K, p: np.array([-1.0]))
     monkeypatch.setattr(simulation, "closed_loop_stable", lambda K, d, p: True)
     monkeypatch.setattr(simulation, "simulate", simulate)
     u, x1 = worst_bump_seats(control.ss([], [], [], [[0.0, 0.0]]), occ,

@@ -343,14 +343,14 @@ def _design_api():
     """The seat designs (imported late: they are heavy, and tests replace them)."""
     from types import SimpleNamespace
 
-    from ..seat import design, refine, routes
+    from ..seat import augmented, design, record, refine, routes
     return SimpleNamespace(
         design_seat=routes.design_seat, load_seat_design=routes.load_seat_design,
-        certify_seat=routes.certify_seat,
+        certify_seat=record.certify_seat,
         load_refined_tradeoff=refine.load_refined_tradeoff,
         analyse_uncertainty=design.analyse_uncertainty,
         design_nominal_hinf=design.design_nominal_hinf,
-        DEFAULT_DESIGN=design.DEFAULT_DESIGN, DEFAULT_MUSYN=design.DEFAULT_MUSYN)
+        DEFAULT_DESIGN=augmented.DEFAULT_DESIGN, DEFAULT_MUSYN=design.DEFAULT_MUSYN)
 
 
 def _jsonable(obj):

@@ -21,7 +21,7 @@ from __future__ import annotations
 import logging
 import math
 import numbers
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import control
 import numpy as np
@@ -34,7 +34,8 @@ from .uncertainty import (DelayUncertainty, delay_uncertainty, paper_norm_bounde
 from .weights import wk_weight
 
 __all__ = ["SeatDesignOptions", "SeatAugmentedPlant", "seat_augmented_plant",
-           "disturbance_weight", "BUMP_PEAK_VELOCITY"]
+           "disturbance_weight", "BUMP_PEAK_VELOCITY", "DEFAULT_DESIGN",
+           "CONSTRAINED_DESIGN"]
 
 logger = logging.getLogger(__name__)
 
@@ -191,6 +192,70 @@ class SeatDesignOptions:
         object.__setattr__(self, "stiffness", tuple(self.stiffness))
         object.__setattr__(self, "damping", tuple(self.damping))
 
+
+#: Weights of the robust design. The disturbance model is shaped like the bump it has to
+#: reject: ``w_scale s/(s + w_corner) · ω_r²/(s² + √2 ω_r s + ω_r²)`` m/s per unit ``w``
+#: follows the velocity spectrum ``|Ẑ0(jω)|`` of eq. (32) over 1–30 rad/s and falls off
+#: with it above its main lobe (≈ 45 rad/s), where a flat design disturbance made µ peak
+#: (65 rad/s) in a band in which the 25 ms delay forbids control and the bump has no
+#: energy. Measured 2026-11-23 (seed 0, idle 2-core machine, ≈ 3 s with the bisection
+#: Riccati K-step): certified µ = 0.854 (upper = lower bound) over the delay cover; bump
+#: peak z̈3 9.06 / 8.42 / 7.87 / 7.34 / 7.79 / 9.03 m/s² at 0 / 5 / … / 25 ms, i.e. 1.47 / 1.37 /
+#: 1.28 / 1.19 / 1.26 / 1.46 × the physical limit 6.164 (at most 1.471 on a 2.5 ms grid
+#: over 0–25 ms; was 1.25–1.60 with acc_ref 3, u_max 3000, z_max 0.10, noise 0.5 mm,
+#: w_corner 13.5, w_rolloff 45, delay_order 2: 9.86 m/s² at 0 ms, 9.71 at 25 ms); peak
+#: x1 0.060 m (≤ 0.08); delay margin 0.216 s. What limits the two ends is different:
+#: at 0 ms the controller commands up to 2830 N and the 1500 N saturation sets the peak
+#: (3.3 m/s² without saturation); at 25 ms the peak is the linear loop's (8.2 m/s²
+#: unsaturated). Larger force scales lower the 25 ms peak, more x1 noise and a lower
+#: floor-velocity corner lower the 0 ms peak (≈ 100 trials, the report on issue 6).
+DEFAULT_DESIGN = SeatDesignOptions(
+    # Wk-weighted z̈3 of 3.14 m/s² per unit w (with the force and stroke scales below;
+    # 3.0: µ 0.874 and 9.17 / 8.87 m/s² at 0 / 25 ms; 3.3: µ 0.832 and 8.98 / 9.19).
+    acc_ref=3.14,
+    # Second-order Wk: the fourth-order fit's slow poles make the LMI K-step's controller
+    # reconstruction fail (SolverError) even on the nominal plant; order 2 solves.
+    wk_order=2,
+    # Force and stroke scales of the error (tuning knobs, not the limits): 7000 N and
+    # 0.114 m. A smaller force scale does not lower the force the controller asks for on
+    # the bump (≈ 2500 N at 1000–1500 N scales, measured) but makes the loop less
+    # tolerant of the delay (25 ms peak 11.2–14.8 m/s²); with the other weights below,
+    # 3000 → 7000 N takes the 25 ms peak from 10.09 to 9.02 m/s² (0 ms: 8.85 → 9.07).
+    # The limits themselves are checked by the exact-delay simulation, which saturates
+    # the force at params.u_max = 1500 N and keeps |x1| ≤ 0.060 m on the bump.
+    u_max=7000.0,
+    z_max=0.114,
+    # Sensor noise per unit n: 1.7 mm on x1 and 0.1 mm on x3. More noise on x1 lowers
+    # the (saturation-limited) 0 ms peak and raises the 25 ms one; less on x3 lowers
+    # the 25 ms peak (0.5 mm on x3: 9.07 / 9.44 m/s² at 0 / 25 ms). Both keep D21 full
+    # rank (regular H∞ problem).
+    noise=(1.7e-3, 1e-4),
+    # Level, corner and roll-off of the bump-shaped floor velocity (see above): the
+    # corner is near the bump's low-frequency slope (|Ẑ0| ≈ 0.012 m·s × ω, area of the
+    # 0.1 m × 0.24 s raised cosine, against its peak 0.162 m at ≈ 21 rad/s; 13.5 rad/s
+    # matches it but gives 9.32 / 8.71 m/s² at 0 / 25 ms, 12.5 gives 9.19 / 8.86); the
+    # roll-off at 42.3 rad/s gives up the band above the main lobe (60 → 45 lowered µ
+    # from 0.976 to 0.879 with earlier weights; 45 here: 9.11 / 8.87 m/s²).
+    w_scale=0.45,
+    w_corner=11.5,
+    w_rolloff=42.3,
+    force_rolloff_ratio=1.0,
+    # Third-order delay cover: tighter than order 2, which with the weights above ends at
+    # µ 0.927 and 9.34 / 8.80 m/s² at 0 / 25 ms (over 1.5 × the limit at 0 ms).
+    delay_order=3,
+    # Synthesised uncertainty: the delay cover only (see the module docstring).
+    include_parametric=False,
+    include_paper=False,
+    parametric_complex=True,
+)
+
+#: The µ weights of the constrained design: DEFAULT_DESIGN with the force error scaled by
+#: 20000 N instead of 7000 N -- the hard bound limits the force now, and the H∞ objective
+#: is left to comfort and robustness.  Measured 2026-11-25 on the 50-point grid, bump
+#: peak at 0 / 25 ms: 11.8 / 16.9 m/s² with 20000 N (force bound 4000 N, disk 2000
+#: rad/s) against 13.9 / 16.5 with 7000 N (4000 N, damping sector 0.05 instead of the
+#: disk).
+CONSTRAINED_DESIGN = replace(DEFAULT_DESIGN, u_max=20000.0)
 
 @dataclass(frozen=True)
 class SeatAugmentedPlant:

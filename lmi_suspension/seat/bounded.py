@@ -35,10 +35,10 @@ from ..synthesis.constraints import Channel, HinfBound, PeakBound
 from ..synthesis.multiobjective import MultiobjectiveResult, msyn
 from .model import seat_matrices
 from .params import SeatParameters
-from .roads import RoadInput, bump
+from .roads import RoadInput, bump, road_energy
 from .simulate import SimulationResult, simulate
 
-__all__ = ["PeakBoundedDesign", "seat_peak_plant", "road_energy", "design_peak_bounded",
+__all__ = ["PeakBoundedDesign", "seat_peak_plant", "design_peak_bounded",
            "force_tradeoff", "PeakBoundedRoute"]
 
 #: control penalty (per N) and measurement noise (m per unit of w) that regularise the H∞
@@ -71,17 +71,6 @@ def seat_peak_plant(params: SeatParameters | None = None) -> GeneralizedPlant:
     D21 = np.hstack([np.zeros((2, 1)), _EPS * np.eye(2)])
     return GeneralizedPlant.from_matrices(A=M.A, B1=B1, B2=M.B.reshape(n, 1), C1=C1,
                                           C2=M.C3, D12=D12, D21=D21)
-
-
-def road_energy(road: RoadInput) -> float:
-    """``‖w‖₂`` of a floor velocity (trapezoidal rule), m/s·s^½.
-
-    Examples
-    --------
-    >>> round(road_energy(bump()), 4)
-    0.4534
-    """
-    return float(np.sqrt(np.trapezoid(np.asarray(road.w) ** 2, road.t)))
 
 
 @dataclass(frozen=True)
@@ -209,10 +198,10 @@ class PeakBoundedRoute:
 
     def design(self, params: SeatParameters, *, rng=None, progress=None):
         """:func:`design_peak_bounded` at ``params`` (nothing random, no iterations to
-        report), as a :class:`~.routes.SeatDesign`."""
+        report), as a :class:`~.record.SeatDesign`."""
         import time
 
-        from .routes import seat_design_from
+        from .record import seat_design_from
 
         t0 = time.perf_counter()
         d = design_peak_bounded(self.u_max, self.z_max, params=params)

@@ -25,14 +25,15 @@ gives at most 1095 N on the bump.
 A design takes minutes (each K-step with the disk about 70–110 s on a 2-core machine),
 so ``reproduce`` loads the shipped one (:data:`SHIPPED_CONTROLLER`, written by
 ``lmi-suspension design-constrained``) and re-certifies it with
-:func:`certify_constrained`, which recomputes everything from the controller alone.
+:func:`~.mucheck.certify_constrained`, which recomputes everything from the controller
+alone.
 """
 
 from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import ClassVar
 
@@ -41,16 +42,14 @@ import numpy as np
 
 from ..mu import MusynOptions, MusynResult, musyn
 from ..synthesis.constraints import Channel, Disk, PeakBound
-from .augmented import SeatDesignOptions, seat_augmented_plant
-from .bounded import road_energy
-from .design import DEFAULT_DESIGN, _named
+from .augmented import CONSTRAINED_DESIGN, SeatDesignOptions, seat_augmented_plant
+from .design import _named
 from .params import SeatParameters
-from .roads import bump
+from .roads import bump, road_energy
 from .sampled import DEFAULT_SAMPLE_TIME, discretise_controller
 
-__all__ = ["ConstrainedMuDesign", "ConstrainedCheck", "CONSTRAINED_MUSYN",
-           "CONSTRAINED_DESIGN", "CONSTRAINED_OMEGA", "TRADEOFF_DELAYS", "TradeoffPoint",
-           "bump_figures", "certify_constrained", "constrained_tradeoff",
+__all__ = ["ConstrainedMuDesign", "CONSTRAINED_MUSYN", "CONSTRAINED_OMEGA",
+           "TRADEOFF_DELAYS", "TradeoffPoint", "bump_figures", "constrained_tradeoff",
            "design_constrained_mu", "load_constrained", "load_tradeoff", "save_constrained",
            "SHIPPED_CONTROLLER", "SHIPPED_TRADEOFF", "ConstrainedRoute"]
 
@@ -73,14 +72,6 @@ CONSTRAINED_MUSYN = MusynOptions(method="lmi", max_iter=4, patience=1, max_dfit_
 #: with the 50-point grid from 0.1 rad/s certified µ 1.218 on it and 2.343 at 1e-3 rad/s
 #: (2026-11-25).
 CONSTRAINED_OMEGA = np.logspace(-3.0, 3.5, 66)
-
-#: The µ weights of the constrained design: DEFAULT_DESIGN with the force error scaled by
-#: 20000 N instead of 7000 N -- the hard bound limits the force now, and the H∞ objective
-#: is left to comfort and robustness.  Measured 2026-11-25 on the 50-point grid, bump
-#: peak at 0 / 25 ms: 11.8 / 16.9 m/s² with 20000 N (force bound 4000 N, disk 2000
-#: rad/s) against 13.9 / 16.5 with 7000 N (4000 N, damping sector 0.05 instead of the
-#: disk).
-CONSTRAINED_DESIGN = replace(DEFAULT_DESIGN, u_max=20000.0)
 
 #: Lyapunov scales of the force/stroke bound and the disk (msyn's ``lyapunov_scales``):
 #: the search of the first K-step found 1.35e5–1.40e5 for the force bound at 3000 N on
@@ -138,77 +129,6 @@ class ConstrainedMuDesign:
     def __iter__(self):
         # like musyn: K, CL, mu_peak, info
         return iter((self.K, self.musyn.CL, self.mu_peak, self))
-
-
-@dataclass(frozen=True)
-class ConstrainedCheck:
-    """What a seat controller achieves against the constrained design's requirements,
-    recomputed from the controller alone (:func:`certify_constrained`).
-
-    Attributes
-    ----------
-    mu_peak, mu_lower_peak : float
-        µ bounds' peaks over ``omega`` (delay cover 0–25 ms and performance).
-    omega, mu_upper, mu_lower : ndarray
-        The grid (rad/s) and the bounds on it.
-    u_peak, x1_peak : float
-        Worst-case ``|u|`` (N) and ``|x1|`` (m) over every floor velocity of energy
-        ``energy`` (closed-loop Gramian).
-    energy : float
-    fastest_pole, controller_fastest_pole : float
-        Largest closed-loop and controller pole magnitudes, rad/s.
-    """
-
-    mu_peak: float
-    mu_lower_peak: float
-    omega: np.ndarray
-    mu_upper: np.ndarray
-    mu_lower: np.ndarray
-    u_peak: float
-    x1_peak: float
-    energy: float
-    fastest_pole: float
-    controller_fastest_pole: float
-
-
-def certify_constrained(K, *, design: SeatDesignOptions | None = None,
-                        params: SeatParameters | None = None, energy: float | None = None,
-                        omega=None, rng: np.random.Generator | None = None
-                        ) -> ConstrainedCheck:
-    """µ bounds, worst-case force and stroke, and pole magnitudes of a seat controller
-    (any: the µ controller's figures come out the same way).
-
-    Examples
-    --------
-    >>> import control
-    >>> c = certify_constrained(control.ss([], [], [], [[0.0, 0.0]]),
-    ...                         omega=np.logspace(-1, 3, 20))
-    >>> c.u_peak, round(c.x1_peak, 4)      # the passive seat: no force, 0.064 m
-    (0.0, 0.0642)
-    """
-    from ..lti import freqresp, lft
-    from ..mu import mussv
-    from ..mu.steps import mu_part as _mu_part
-    from ..umodel.blocks import BlockStructure
-
-    E = road_energy(bump()) if energy is None else float(energy)
-    aug = seat_augmented_plant(CONSTRAINED_DESIGN if design is None else design, params,
-                               peak_channels=True)
-    omega = (np.logspace(np.log10(CONSTRAINED_OMEGA[0]), np.log10(CONSTRAINED_OMEGA[-1]),
-                         300) if omega is None else np.asarray(omega, dtype=float))
-    K = control.ss(K.A, K.B, K.C, K.D)
-    CL = lft(aug.P, K, aug.nmeas, aug.ncon)
-    struct = BlockStructure.coerce(aug.blk)
-    nz, nw = struct.shape_M
-    bounds = mussv(freqresp(_mu_part(CL, struct), omega), aug.blk,
-                   omega=omega, rng=np.random.default_rng(0) if rng is None else rng)
-    peaks = PeakBound(Channel(outputs=(nz, nz + 1), inputs=(nw,)), (1.0, 1.0)).peaks(CL) * E
-    fast = (lambda M: float(np.max(np.abs(np.linalg.eigvals(M)))) if M.size else 0.0)
-    return ConstrainedCheck(
-        mu_peak=float(np.max(bounds.upper)), mu_lower_peak=float(np.max(bounds.lower)),
-        omega=omega, mu_upper=np.asarray(bounds.upper), mu_lower=np.asarray(bounds.lower),
-        u_peak=float(peaks[0]), x1_peak=float(peaks[1]), energy=E,
-        fastest_pole=fast(np.asarray(CL.A)), controller_fastest_pole=fast(np.asarray(K.A)))
 
 
 def design_constrained_mu(u_bound: float = 9000.0, z_bound: float = 0.16, *,
@@ -353,9 +273,9 @@ class ConstrainedRoute:
     musyn_options: MusynOptions | None = None
 
     def design(self, params: SeatParameters, *, rng: np.random.Generator, progress=None):
-        """:func:`design_constrained_mu` at ``params``, as a :class:`~.routes.SeatDesign`."""
+        """:func:`design_constrained_mu` at ``params``, as a :class:`~.record.SeatDesign`."""
         from .design import _dk_line
-        from .routes import seat_design_from
+        from .record import seat_design_from
 
         cb = None if progress is None else (lambda rec: progress(_dk_line(rec)))
         weights = CONSTRAINED_DESIGN if self.design_options is None else self.design_options

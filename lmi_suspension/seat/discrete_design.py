@@ -31,8 +31,13 @@ from ..errors import ParameterError
 from ..lti.bilinear import tustin_image
 from ..lti.checks import as_statespace, positive_scalar, sample_time
 from ..mu import MusynOptions, MusynResult, musyn
-from .augmented import SeatAugmentedPlant, SeatDesignOptions, seat_augmented_plant
-from .design import DEFAULT_DESIGN, DEFAULT_MUSYN, DEFAULT_OMEGA
+from .augmented import (
+    DEFAULT_DESIGN,
+    SeatAugmentedPlant,
+    SeatDesignOptions,
+    seat_augmented_plant,
+)
+from .design import DEFAULT_MUSYN, DEFAULT_OMEGA
 from .model import seat_model
 from .params import SeatParameters
 from .sampled import DEFAULT_SAMPLE_TIME
@@ -208,8 +213,8 @@ class DiscreteMuRoute:
 
     def design(self, params: SeatParameters, *, rng: np.random.Generator, progress=None):
         """:func:`design_discrete_mu_controller` at ``params``, as a
-        :class:`~.routes.SeatDesign`."""
-        from .routes import seat_design_from
+        :class:`~.record.SeatDesign`."""
+        from .record import seat_design_from
 
         d = design_discrete_mu_controller(self.dt, self.design_options, params=params,
                                           musyn_options=self.musyn_options, rng=rng)

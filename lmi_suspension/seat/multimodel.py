@@ -37,9 +37,9 @@ import numpy as np
 
 from ..errors import ParameterError
 from .augmented import SeatDesignOptions
+from .loop import _LIMIT_DT, BumpResponse, loop_poles
 from .occupants import OccupantSet
-from .refine import (_LIMIT_DT, BumpResponse, RefinedDesign, RefineOptions, loop_poles,
-                     refine_seat_controller)
+from .refine import RefinedDesign, RefineOptions, refine_seat_controller
 from .roads import RoadInput, bump
 from .worstcase import worst_bump_seats
 
@@ -284,7 +284,7 @@ class OccupantRoute:
         As :func:`refine_for_occupants`.
     design_options : SeatDesignOptions, optional
         The µ weights and delay cover of the refinement
-        (:data:`~.design.DEFAULT_DESIGN` by default).
+        (:data:`~.augmented.DEFAULT_DESIGN` by default).
 
     Examples
     --------
@@ -304,9 +304,10 @@ class OccupantRoute:
     def design(self, params, *, rng: np.random.Generator, progress=None):
         """The start (given or designed), refined for the set around ``params``; two
         streams spawned from ``rng``: the start's route's and the worst-case search's."""
-        from .design import DEFAULT_DESIGN, MuRoute
+        from .augmented import DEFAULT_DESIGN
+        from .design import MuRoute
+        from .record import seat_design_from
         from .refine import _description, _figures, _start
-        from .routes import seat_design_from
 
         occupants = OccupantSet(nominal=params) if self.occupants is None else self.occupants
         if params != occupants.nominal:

@@ -13,7 +13,7 @@ take part in any design of this package:
   (:func:`~.simulate.closed_loop_stable`) at each stability sample's own delay;
 * **the road requirements** at every performance sample and every delay of
   ``delays``: peak ``|z̈3|`` over the sample's own limit, commanded ``|u|`` (unclipped)
-  and ``|x1|``, in closed form in the frequency domain (:class:`~.refine.BumpResponse`),
+  and ``|x1|``, in closed form in the frequency domain (:class:`~.loop.BumpResponse`),
   the worst few re-simulated in the time domain (:func:`~.simulate.simulate`, exact
   delay) and the larger of the two figures reported;
 * **mixed µ** (:func:`occupant_mu`): the set's parameters as real scalars with the
@@ -167,7 +167,7 @@ class OccupantSet:
         """The µ weights of ``design`` (the seat design's by default) with this set's
         parameters as real scalars ``[-1, 0]`` and its delay range: the mixed-µ
         structure of :func:`occupant_mu`."""
-        from .design import DEFAULT_DESIGN
+        from .augmented import DEFAULT_DESIGN
 
         design = DEFAULT_DESIGN if design is None else design
         damping = _ELEMENTS[3:] if self.damping_rel > 0 else ()
@@ -229,7 +229,7 @@ def occupant_samples(occupants: OccupantSet | None = None, *, rng: np.random.Gen
         Called with a line of text every 20 limits.
     """
     from .limit import bump_limit
-    from .refine import _LIMIT_DT
+    from .loop import _LIMIT_DT
 
     occupants = OccupantSet() if occupants is None else occupants
     road = bump() if road is None else road
@@ -331,7 +331,7 @@ def certify_occupants(K, samples: OccupantSamples, *, delays=None, confirm: int 
     -------
     OccupantCheck
     """
-    from .refine import REFINE_DELAYS, BumpResponse, loop_poles
+    from .loop import REFINE_DELAYS, BumpResponse, loop_poles
     from .simulate import closed_loop_stable, simulate
 
     t0 = time.perf_counter()
@@ -473,7 +473,7 @@ def _lower_bound_seat(aug, rs) -> tuple[SeatParameters | None, float]:
 def occupant_mu(K, occupants: OccupantSet | None = None, *, design=None, omega=None,
                 rng: np.random.Generator) -> MixedMuCheck:
     """Mixed real/complex µ of ``K`` over the set: the parameters as real scalars, the
-    delay cover and performance block of ``design`` (:data:`~.design.DEFAULT_DESIGN` by
+    delay cover and performance block of ``design`` (:data:`~.augmented.DEFAULT_DESIGN` by
     default) complex; upper bounds of :func:`~lmi_suspension.mu.mussv` (SLICOT's AB13MD
     on the default structure, its scalings checked; the LMI where a design has blocks
     AB13MD does not take) on the grid and over every frequency
@@ -583,7 +583,7 @@ class MixedRsBound:
     ----------
     occupants : OccupantSet, optional
     design : SeatDesignOptions, optional
-        The delay cover (:data:`~.design.DEFAULT_DESIGN` by default).
+        The delay cover (:data:`~.augmented.DEFAULT_DESIGN` by default).
     omega : array_like, optional
         Grid, rad/s (200 points over 0.1–3162 rad/s by default).
 
@@ -640,7 +640,7 @@ class MixedRsBound:
 
     def loop_poles(self, K) -> np.ndarray:
         """Poles of the loop (the weights' and the delay cover's included)."""
-        from .refine import interconnection_poles
+        from .loop import interconnection_poles
 
         return interconnection_poles(self._P, K, self._nw, self._nu, self._nz, self._ny)
 
@@ -696,7 +696,7 @@ class MixedRsBound:
     def levels(self, K, scal: RsScalings) -> np.ndarray:
         """``β`` at each of ``scal``'s frequencies for ``K``: upper bounds of its µ there
         (``K``'s loop must be stable; :meth:`loop_poles` tells)."""
-        from .refine import loop_response
+        from .loop import loop_response
 
         M = loop_response(K, scal.omega, scal._blocks)                  # (F, nq, np)
         MH = np.conj(np.swapaxes(M, 1, 2))

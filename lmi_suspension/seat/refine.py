@@ -5,23 +5,29 @@ convex with one Lyapunov matrix for every specification; on the seat that costs 
 performance (µ 0.854 → 2.57) and the force it leaves unused (the bump asks 1095 N of the
 1500 N). This module takes the other classical route, that of structured H∞ tuning
 (MATLAB's ``systune``/``hinfstruct``; Apkarian & Noll, IEEE TAC 51(1), 2006): the
-controller's order is fixed, its real modal realization is the decision vector, and a
-local gradient method (SciPy's SLSQP) minimises the bump's peak upper-body acceleration
-over the delays subject to every requirement *evaluated exactly*, not bounded:
+controller's order is fixed, its real modal realization is the decision vector
+(:func:`~lmi_suspension.tune.tunable_modal`), and :func:`~lmi_suspension.tune.systune`'s
+SLSQP route (SciPy's SLSQP in trust-region stages, :mod:`lmi_suspension.tune.stages`)
+minimises the bump's peak upper-body acceleration over the delays subject to every
+requirement *evaluated exactly*, not bounded -- the requirement classes of
+:mod:`.goals`:
 
 * the bump response at each delay, in closed form in the frequency domain: the loop
   with the exact delay ``e^{-sτ}``, linear and unclipped, transformed back by FFT
-  (:class:`BumpResponse`; it matches the time-stepping :func:`~.simulate.simulate`
+  (:class:`~.loop.BumpResponse`; it matches the time-stepping :func:`~.simulate.simulate`
   within 0.2 %, a test checks it);
 * µ over the delay cover and the performance block: the structure is two full complex
   blocks, for which µ equals its D-scaled upper bound (Packard & Doyle, Automatica
   29(1), 1993, Sec. 9.1: 2S + F ≤ 3), minimised per frequency over the one scale ratio
-  (:class:`TwoBlockMu`; a test compares it with :func:`~lmi_suspension.mu.mussv`);
+  (:class:`~.loop.TwoBlockMu`; a test compares it with :func:`~lmi_suspension.mu.mussv`);
 * the magnitudes of the controller's and the loop's poles (a disk a 1 kHz controller
   resolves) and the loop's stability.
 
-The result is a local optimum from the start it is given, not a global one. It is
-certified by computations that did not produce it (:func:`certify_refined`): the
+This module holds no optimiser of its own: it chooses the requirements, the start and
+the stage lengths, and reads the figures back.  The result is a local optimum from the
+start it is given, not a global one.  ``systune`` recomputes each requirement by
+another route (``RefinedDesign.certificate``), and :func:`certify_refined` certifies
+the controller by computations that did not produce it: the
 exact-delay time simulation at each delay, µ upper and lower bounds of
 :func:`~lmi_suspension.mu.mussv` on a dense grid, and the closed-loop poles.
 """
@@ -36,307 +42,29 @@ from typing import ClassVar
 
 import control
 import numpy as np
-from scipy import linalg, optimize
+from scipy import linalg
 
-from ..errors import DimensionError, InputError, ParameterError
-from .augmented import SeatDesignOptions, seat_augmented_plant
-from .model import seat_matrices
+from ..errors import DimensionError, ParameterError
+from .augmented import DEFAULT_DESIGN, SeatDesignOptions
+from .goals import (
+    BumpForce,
+    BumpPeak,
+    BumpStroke,
+    MuBound,
+    PoleDisk,
+    PoleShape,
+    SeatLoops,
+    SeatSeat,
+)
+from .loop import _LIMIT_DT, REFINE_DELAYS, BumpResponse, TwoBlockMu
 from .params import SeatParameters
 from .roads import RoadInput, bump
 
-__all__ = ["BumpResponse", "TwoBlockMu", "RefineOptions", "RefineStage", "RefinedDesign",
-           "REFINE_DELAYS", "SHIPPED_REFINED", "certify_refined",
-           "SHIPPED_REFINED_TRADEOFF", "frequency_response", "load_refined",
-           "load_refined_tradeoff", "loop_poles", "modal_form",
-           "refine_seat_controller", "save_refined", "RefineRoute"]
+__all__ = ["SHIPPED_REFINED", "SHIPPED_REFINED_TRADEOFF", "RefineOptions", "RefineRoute",
+           "RefineStage", "RefinedDesign", "certify_refined", "load_refined",
+           "load_refined_tradeoff", "modal_form", "refine_seat_controller", "save_refined"]
 
 logger = logging.getLogger(__name__)
-
-#: The delays the bump requirements are evaluated at, s (the issue's 0, 5, ..., 25 ms).
-REFINE_DELAYS = (0.0, 0.005, 0.01, 0.015, 0.02, 0.025)
-
-#: Record length of the FFT, s: every loop pole decays at least at _MIN_DECAY = 0.5
-#: rad/s (a constraint of the search), by e^-12 at 24 s, so the circular convolution
-#: does not wrap.  (With 16 s and 0.05 rad/s the search found a loop whose wrapped FFT
-#: response met 2000 N while the time simulation commanded 2424 N, 2026-11-26.)
-_FFT_HORIZON = 24.0
-#: The peak refinement between grid points: the bracket (two grid spacings, 0.08
-#: decades) sampled at this many points, then the bracket around the best, this many
-#: times: 0.08 / 12² ≈ 6e-4 decades (0.13 % in frequency) at the end, where a peak of
-#: damping 0.1 is within 1e-4 of its top.  One batched evaluation per zoom: a golden
-#: section (20 steps) cost 32 ms per controller against 9 ms for the grid.
-_PEAK_POINTS = 13
-_PEAK_ZOOMS = 2
-#: Golden-section steps of the per-frequency scale search (on log d in [-10, 10]: the
-#: bracket shrinks to 20 · 0.618^30 ≈ 1e-5, and µ is flat to second order there: 25
-#: steps and 40 gave the µ controller's peak equal to 3e-11, 2026-11-26).
-_GOLDEN_STEPS = 30
-
-
-@dataclass(frozen=True)
-class BumpResponse:
-    """Peaks of the seat's response to a road at several actuator delays, for any
-    linear controller ``u = K y``, in closed form in the frequency domain.
-
-    With ``u_a = e^{-sτ} u``: ``u = K (G_yw w + G_yu u_a)``, so
-    ``u = K G_yw w / (1 - K G_yu e^{-sτ})``; ``z̈3`` and ``x1`` follow from ``w`` and
-    ``u_a``. The road is zero-padded to :data:`_FFT_HORIZON` and transformed once; each
-    controller costs one frequency response and one inverse FFT per delay. No clipping:
-    this is the linear loop whose commanded force the requirements bound.
-
-    Parameters
-    ----------
-    road : RoadInput, optional
-        The paper's bump by default; its sample period is the FFT's.
-    delays : sequence of float
-        Actuator delays, s.
-    params : SeatParameters, optional
-
-    Examples
-    --------
-    >>> import control
-    >>> z, u, x1 = BumpResponse(delays=(0.0,)).peaks(control.ss([], [], [], [[0.0, 0.0]]))
-    >>> round(float(z[0]), 2)               # passive seat (FACTS.md: 26.47 m/s²)
-    26.47
-    """
-
-    road: RoadInput | None = None
-    delays: tuple = REFINE_DELAYS
-    params: SeatParameters | None = None
-
-    def __post_init__(self):
-        road = bump() if self.road is None else self.road
-        if not isinstance(road, RoadInput):
-            raise ParameterError(f"road must be a RoadInput, got {type(road).__name__}")
-        delays = np.asarray(self.delays, dtype=float).ravel()
-        if delays.size == 0 or not np.all(np.isfinite(delays)) or np.any(delays < 0):
-            raise ParameterError(f"delays must be finite and non-negative, got {self.delays!r}")
-        dt = float(road.t[1] - road.t[0])
-        n = int(round(max(_FFT_HORIZON, 4 * (road.t[-1] - road.t[0])) / dt))
-        w = np.zeros(n)
-        w[:road.w.size] = road.w
-        s = 2j * np.pi * np.fft.rfftfreq(n, dt)
-        M = seat_matrices(self.params)
-        lam, V = np.linalg.eig(M.A)
-        Vi = np.linalg.inv(V)
-        resolvent = 1.0 / (s[None, :] - lam[:, None])
-
-        def fr(C, B):  # C (sI - A)^-1 B on the grid, (p, m, F)
-            return np.einsum("pn,nm,nf->pmf", C @ V, Vi @ B, resolvent)
-
-        cache = dict(n=n, dt=dt, s=s, W=np.fft.rfft(w), keep=road.w.size,
-                     Gy_w=fr(M.C3, M.Bw), Gy_u=fr(M.C3, M.B), Gz_w=fr(M.C1, M.Bw)[0, 0],
-                     Gz_u=fr(M.C1, M.B)[0, 0], Gx_w=fr(M.C2, M.Bw)[0, 0],
-                     Gx_u=fr(M.C2, M.B)[0, 0], E=np.exp(-np.outer(delays, s)))
-        object.__setattr__(self, "_c", cache)
-
-    def peaks(self, K) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """``(peak |z̈3|, peak |u| commanded, peak |x1|)``, one entry per delay, over
-        the road's record.  The loop must be stable (see :func:`loop_poles`)."""
-        c = self._c
-        Kw = frequency_response(K, c["s"])
-        KGu = np.einsum("yf,yf->f", Kw, c["Gy_u"][:, 0])
-        KGw = np.einsum("yf,yf->f", Kw, c["Gy_w"][:, 0])
-        U = KGw * c["W"] / (1.0 - KGu * c["E"])
-        Ua = U * c["E"]
-        Z = c["Gz_w"] * c["W"] + c["Gz_u"] * Ua
-        X = c["Gx_w"] * c["W"] + c["Gx_u"] * Ua
-        k = c["keep"]
-        peak = (lambda F: np.max(np.abs(np.fft.irfft(F, c["n"])[:, :k]), axis=1))
-        return peak(Z), peak(U), peak(X)
-
-
-def frequency_response(K, s: np.ndarray) -> np.ndarray:
-    """``K(s)`` of a one-output controller at the points ``s``, shape ``(ny, len(s))``,
-    by its eigendecomposition (cheap for many points)."""
-    A, B, C, D = (np.asarray(m, dtype=float) for m in (K.A, K.B, K.C, K.D))
-    if C.shape[0] != 1:
-        raise DimensionError(f"a seat controller has one output, got {C.shape[0]}")
-    if A.size == 0:
-        return np.repeat(D.T, len(s), axis=1)
-    lam, V = np.linalg.eig(A)
-    r = (C @ V)[0][:, None] * np.linalg.solve(V, B)          # (n, ny) residues
-    return np.einsum("ny,nf->yf", r, 1.0 / (s[None, :] - lam[:, None])) + D.T
-
-
-def loop_response(K, omega: np.ndarray, blocks) -> np.ndarray:
-    """``F_l(P, K)(jω)`` of a plant with one control input, shape ``(F, nz, nw)``, from
-    the plant's responses ``blocks = (P11, P12, P21, P22)`` on ``omega`` (``P12`` and
-    ``P22`` with their one input column dropped)."""
-    P11, P12, P21, P22 = blocks
-    Kw = frequency_response(K, 1j * omega)                  # (ny, F)
-    loop = 1.0 - np.einsum("yf,yf->f", Kw, P22)
-    KP21 = np.einsum("yf,ywf->wf", Kw, P21) / loop
-    return np.moveaxis(P11 + P12[:, None, :] * KP21[None, :, :], -1, 0)
-
-
-def interconnection_poles(P, K, nw: int, nu: int, nz: int, ny: int) -> np.ndarray:
-    """Poles of ``F_l(P, K)`` where ``P`` has ``nw + nu`` inputs and ``nz + ny``
-    outputs and ``D22 = 0``, as every seat plant here has (a nonzero ``D22`` is an
-    :class:`InputError`: the formula below would be wrong for it)."""
-    A, B, C = (np.asarray(m, dtype=float) for m in (P.A, P.B, P.C))
-    if np.any(np.asarray(P.D, dtype=float)[nz:nz + ny, nw:nw + nu] != 0):
-        raise InputError("interconnection_poles needs D22 = 0")
-    B2, C2 = B[:, nw:nw + nu], C[nz:nz + ny]
-    Ak, Bk, Ck, Dk = (np.asarray(m, dtype=float) for m in (K.A, K.B, K.C, K.D))
-    return np.linalg.eigvals(np.block([[A + B2 @ Dk @ C2, B2 @ Ck], [Bk @ C2, Ak]]))
-
-
-def loop_poles(K, params: SeatParameters | None = None) -> np.ndarray:
-    """Poles of the seat with ``u = K y`` and no delay."""
-    M = seat_matrices(params)
-    A, B, C, D = (np.asarray(m, dtype=float) for m in (K.A, K.B, K.C, K.D))
-    Acl = np.block([[M.A + M.B @ D @ M.C3, M.B @ C], [B @ M.C3, A]])
-    return np.linalg.eigvals(Acl)
-
-
-@dataclass(frozen=True)
-class TwoBlockMu:
-    """µ of the seat's closed loop over a structure of two full complex blocks, on a
-    frequency grid, for any controller ``u = K y``.
-
-    For two full complex blocks µ equals its upper bound ``min_D σ̄(D M D⁻¹)``
-    (Packard & Doyle 1993: 2S + F ≤ 3), and ``D = diag(d I, I)`` has one free ratio,
-    found per frequency by a golden-section search on ``log d`` (vectorised over the
-    grid).  The plant's responses are computed once; each controller costs one
-    frequency response and a batch of small SVDs.
-
-    Parameters
-    ----------
-    design : SeatDesignOptions
-        The µ weights (the structure must be two full complex blocks, as the paper's
-        delay cover with the performance block is).
-    omega : array_like
-        Grid, rad/s.
-    params : SeatParameters, optional
-    """
-
-    design: SeatDesignOptions
-    omega: np.ndarray
-    params: SeatParameters | None = None
-
-    def __post_init__(self):
-        from ..lti import freqresp
-        from ..umodel.blocks import BlockStructure
-
-        aug = seat_augmented_plant(self.design, self.params)
-        blk = np.asarray(aug.blk)
-        if blk.shape != (2, 2) or np.any(blk <= 0):
-            raise DimensionError(f"TwoBlockMu needs two full complex blocks, got blk "
-                                 f"{blk.tolist()}")
-        nz, nw = BlockStructure.coerce(aug.blk).shape_M
-        omega = np.asarray(self.omega, dtype=float).ravel()
-        if omega.size < 2 or np.any(omega <= 0) or not np.all(np.isfinite(omega)):
-            raise ParameterError("omega must hold positive finite frequencies")
-        ny, nu = aug.nmeas, aug.ncon
-        object.__setattr__(self, "_c", dict(
-            omega=omega, P=aug.P, nz=nz, nw=nw, ny=ny, nu=nu,
-            rows=int(blk[0, 1]), cols=int(blk[0, 0])))
-        self._c["grid"] = self._blocks(freqresp(aug.P, omega))
-
-    def _blocks(self, Pw):
-        c = self._c
-        nz, nw, ny, nu = c["nz"], c["nw"], c["ny"], c["nu"]
-        return (Pw[:nz, :nw], Pw[:nz, nw:nw + nu][:, 0], Pw[nz:nz + ny, :nw],
-                Pw[nz:nz + ny, nw:nw + nu][:, 0])
-
-    def loop_poles(self, K) -> np.ndarray:
-        """Poles of the µ loop ``F_l(P, K)`` (the weights' poles included)."""
-        c = self._c
-        return interconnection_poles(c["P"], K, c["nw"], c["nu"], c["nz"], c["ny"])
-
-    def _loop(self, K, omega=None) -> np.ndarray:
-        """The closed loop's response, shape ``(F, nz, nw)``, on the grid or at ``omega``."""
-        from ..lti import freqresp
-
-        c = self._c
-        if omega is None:
-            omega, (P11, P12, P21, P22) = c["omega"], c["grid"]
-        else:
-            omega = np.asarray(omega, dtype=float).ravel()
-            P11, P12, P21, P22 = self._blocks(freqresp(c["P"], omega))
-        return loop_response(K, omega, (P11, P12, P21, P22))
-
-    def cover_gain(self, K, omega=None) -> np.ndarray:
-        """σ̄ of the first block's channel on the grid, or at ``omega`` (rad/s): µ of
-        robust stability against that block alone (one full complex block: µ is σ̄),
-        the delay cover's."""
-        M = self._loop(K, omega)[:, :self._c["rows"], :self._c["cols"]]
-        return np.linalg.svd(M, compute_uv=False)[:, 0]
-
-    def cover_peaks(self, K, count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The delay cover's gain on the grid and its ``count`` largest local maxima
-        refined between grid points, as :meth:`peaks` does for µ."""
-        return _zoomed_peaks(lambda w=None: self.cover_gain(K, w), self._c["omega"], count)
-
-    def curve(self, K, omega=None) -> np.ndarray:
-        """µ at each grid frequency, or at ``omega`` (rad/s) where given."""
-        c = self._c
-        M = self._loop(K, omega)
-        r, k = c["rows"], c["cols"]
-
-        def scaled_norm(log_d):
-            d = np.exp(log_d)[:, None, None]
-            S = M.copy()
-            S[:, :r, :] *= d
-            S[:, :, :k] /= d
-            # σ̄ by the largest eigenvalue of SᴴS: half the time of a batched SVD
-            return np.sqrt(np.linalg.eigvalsh(np.conj(np.swapaxes(S, 1, 2)) @ S)[:, -1])
-
-        lo = np.full(M.shape[0], -10.0)
-        hi = np.full(M.shape[0], 10.0)
-        g = (np.sqrt(5.0) - 1.0) / 2.0
-        a, b = hi - g * (hi - lo), lo + g * (hi - lo)
-        fa, fb = scaled_norm(a), scaled_norm(b)
-        for _ in range(_GOLDEN_STEPS):
-            left = fa < fb              # the minimum lies in [lo, b]
-            hi = np.where(left, b, hi)
-            lo = np.where(left, lo, a)
-            a_new = np.where(left, hi - g * (hi - lo), b)
-            b_new = np.where(left, a, lo + g * (hi - lo))
-            a, b = a_new, b_new
-            fa, fb = scaled_norm(a), scaled_norm(b)
-        return np.minimum(fa, fb)
-
-    def peaks(self, K, count: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """µ on the grid, and its ``count`` largest local maxima refined between grid
-        points: ``(curve, peak values, peak frequencies)``.
-
-        Each of the largest local maxima of the grid curve is maximised over the interval
-        between its neighbours by sampling it and zooming in (:data:`_PEAK_POINTS`,
-        :data:`_PEAK_ZOOMS`); where there are fewer maxima, the largest is repeated, so that the
-        number of values is fixed (the search's constraints need that).  A sharp peak
-        between grid points is found this way, which a grid alone can miss.
-        """
-        return _zoomed_peaks(lambda w=None: self.curve(K, w), self._c["omega"], count)
-
-
-def _zoomed_peaks(f, omega: np.ndarray, count: int):
-    """``(f on the grid, its count largest local maxima refined, their frequencies)``
-    for a curve ``f(omega=None)`` given on the grid ``omega`` (see :meth:`TwoBlockMu.peaks`)."""
-    mu = f()
-    w = np.log(omega)
-    inner = np.flatnonzero((mu[1:-1] >= mu[:-2]) & (mu[1:-1] >= mu[2:])) + 1
-    if inner.size == 0:
-        inner = np.array([int(np.clip(np.argmax(mu), 1, mu.size - 2))])
-    top = inner[np.argsort(-mu[inner], kind="stable")][:count]
-    top = np.concatenate([top, np.repeat(top[:1], count)])[:count]
-    lo, hi = w[top - 1], w[top + 1]
-    best_mu, best_w = mu[top], omega[top]
-    cols = np.arange(count)
-    for _ in range(_PEAK_ZOOMS):
-        # every peak's bracket sampled at once (one batched evaluation per zoom)
-        t = np.linspace(0.0, 1.0, _PEAK_POINTS)
-        grid = lo[:, None] + (hi - lo)[:, None] * t[None, :]        # (count, n)
-        vals = f(np.exp(grid.ravel())).reshape(grid.shape)
-        j = np.argmax(vals, axis=1)
-        better = vals[cols, j] > best_mu
-        best_mu = np.where(better, vals[cols, j], best_mu)
-        best_w = np.where(better, np.exp(grid[cols, j]), best_w)
-        step = (hi - lo) / (_PEAK_POINTS - 1)
-        lo, hi = grid[cols, j] - step, grid[cols, j] + step
-    return mu, best_mu, best_w
-
 
 # ----------------------------------------------------------------------------- realization
 
@@ -444,8 +172,8 @@ def modal_form(K, radius: float | None = None) -> control.StateSpace:
 # ----------------------------------------------------------------------------- the search
 
 #: µ grid of the search, rad/s: the certification grid's range at 200 points; µ is also
-#: taken at its refined local maxima and at the loop's least damped poles (_PEAKS,
-#: _RESONANCES), and the certificate adds its own points.
+#: taken at its refined local maxima and at the loop's least damped poles (see
+#: :mod:`.goals`), and the certificate adds its own points.
 _MU_GRID = np.logspace(-3.0, 4.0, 200)
 #: SLSQP iterations per trust-region stage, and the first stage's box half-width in the
 #: normalised parameters (0.5: a gain may move by half its starting magnitude, a pole by
@@ -469,15 +197,6 @@ _RS_STAGE_ITER = 30
 _RS_TRUST_START = 0.1
 _TRUST_START = 0.5
 _TRUST_MIN = 1e-3
-#: every loop pole's real part must stay below minus this (rad/s), so that the FFT
-#: record decays (see _FFT_HORIZON); the µ controller's slowest is 0.66
-_MIN_DECAY = 0.5
-#: and its damping ratio above this: µ's peak at a pole of damping ζ is about 2ζ wide,
-#: so a grid cannot hide it (the search hid a peak µ 1.72 at 1.9 rad/s from a 150-point
-#: grid, 2026-11-26); the µ controller's least damped loop pole has ζ = 0.52
-_MIN_DAMPING = 0.05
-#: how many of the slowest and the least damped poles carry those constraints
-_SHAPE_POLES = 4
 #: SLSQP ends on the constraints' boundary, a little outside (1.5e-4 relative on µ in
 #: the first trial, which then rejected every later stage as "more violation"), and the
 #: FFT's bump figures differ from the time simulation's by up to 0.2 % (with a margin of
@@ -485,47 +204,6 @@ _SHAPE_POLES = 4
 #: aims at every bound tightened by twice this fraction and counts an excess below it
 #: as met, so that what it returns is within the bounds themselves by about this much.
 _MARGIN = 3e-3
-#: step of the physical limit's LP for ``plants``, s (bump_limit's default; the sweep's;
-#: the occupants' certificate uses it too)
-_LIMIT_DT = 2e-3
-
-
-#: µ's largest local maxima on the grid, refined between grid points
-#: (:meth:`TwoBlockMu.peaks`), are constraints too, this many: on the 150-point grid
-#: alone the search hid a resonance at 76 rad/s between two points, µ 0.978 on the grid
-#: and 1.035 at the peak (2026-11-26).
-_PEAKS = 6
-#: µ is also taken at this many least damped loop pole pairs (|p| and |Im p| of each)
-_RESONANCES = 6
-
-
-def _shape_margins(poles: np.ndarray) -> np.ndarray:
-    """Normalised margins (>= 0 where met) of the :data:`_SHAPE_POLES` slowest poles'
-    decay (:data:`_MIN_DECAY`) and least damped poles' damping (:data:`_MIN_DAMPING`)."""
-    decay = np.sort(-poles.real)[:_SHAPE_POLES] / _MIN_DECAY - 1
-    zeta = np.sort(-poles.real / np.maximum(np.abs(poles), 1e-300))[:_SHAPE_POLES]
-    return np.concatenate([decay, zeta / _MIN_DAMPING - 1])
-
-
-def _cover_points(mu: TwoBlockMu, K, poles: np.ndarray) -> list:
-    """The delay cover's gain where it is bounded: on the grid, at its :data:`_PEAKS`
-    largest maxima refined between grid points, and at the loop's resonances
-    (:func:`_resonance_points`), as µ is for robust performance.  On the grid alone the
-    multi-seat design's cover reached µ 0.999 (mixed, dense grid) at 86.6 rad/s between
-    two points of its 200 (2026-11-27)."""
-    curve, top, _ = mu.cover_peaks(K, _PEAKS)
-    return [curve, top, mu.cover_gain(K, _resonance_points(poles))]
-
-
-def _resonance_points(poles: np.ndarray) -> np.ndarray:
-    """``|p|`` and ``|Im p|`` of the :data:`_RESONANCES` least damped pole pairs (the
-    least damped repeated where there are fewer pairs): a fixed number of frequencies."""
-    p = poles[poles.imag > 0]
-    if p.size == 0:
-        return np.ones(2 * _RESONANCES)
-    p = p[np.argsort(-p.real / np.abs(p), kind="stable")]
-    p = np.concatenate([p, np.repeat(p[:1], _RESONANCES)])[:_RESONANCES]
-    return np.concatenate([np.abs(p), p.imag])
 
 
 @dataclass(frozen=True)
@@ -612,184 +290,6 @@ class RefineOptions:
 
 
 @dataclass(frozen=True)
-class _Point:
-    """One controller's exact figures and how far it is from the requirements."""
-
-    z: np.ndarray           # peak |z3''| per seat and delay (over the seat's limit)
-    u: np.ndarray
-    x1: np.ndarray
-    mu_curve: np.ndarray    # µ on the search grid, at its refined peaks and resonances
-    magnitudes: np.ndarray  # controller and loop pole magnitudes, sorted
-    shape: np.ndarray       # decay and damping margins of the slowest / least damped
-    violation: float        # largest normalised excess over a requirement (0: met)
-
-    @property
-    def mu(self) -> float:
-        return float(np.max(self.mu_curve))
-
-    @property
-    def radius(self) -> float:
-        return float(self.magnitudes[-1])
-
-    @property
-    def objective(self) -> float:
-        return float(np.max(self.z))
-
-    def better_than(self, other: "_Point", tol: float = _MARGIN) -> bool:
-        if self.violation > tol or other.violation > tol:
-            return self.violation < other.violation - tol
-        return self.objective < other.objective * (1 - 1e-6)
-
-
-@dataclass(frozen=True)
-class _Seat:
-    """One seat the requirements are evaluated at."""
-
-    bumpr: BumpResponse
-    unit: float                     # of its peak |z3''|: 1 (m/s²) or its own limit
-    params: SeatParameters | None
-    cover: TwoBlockMu | None        # its delay-cover gain (None: the design seat's µ)
-
-
-class _Problem:
-    """The parametrisation (real modal form, normalised) and the exact evaluations."""
-
-    def __init__(self, K0: control.StateSpace, opts: RefineOptions, seats: list,
-                 mu: TwoBlockMu, rs=None):
-        A = np.asarray(K0.A)
-        self.n = A.shape[0]
-        self.kinds, poles, i = [], [], 0
-        while i < self.n:
-            if i + 1 < self.n and A[i, i + 1] != 0.0:
-                self.kinds.append(2)
-                poles += [np.log(-A[i, i]), np.log(A[i, i + 1])]
-                i += 2
-            else:
-                self.kinds.append(1)
-                poles.append(np.log(-A[i, i]))
-                i += 1
-        self.npole = len(poles)
-        gains = np.concatenate([np.asarray(K0.B).ravel(), np.asarray(K0.C).ravel(),
-                                np.asarray(K0.D).ravel()])
-        self.x0 = np.concatenate([poles, gains])
-        # each gain in units of its own magnitude; an entry that is zero (the rotated
-        # pairs' second output gain) in a tenth of its mode's
-        Bk, Ck, Dk = (np.asarray(m, dtype=float) for m in (K0.B, K0.C, K0.D))
-        mode = np.sqrt(np.sum(Bk ** 2, axis=1) + Ck[0] ** 2)
-        floor = np.concatenate([np.repeat(mode, Bk.shape[1]), mode,
-                                np.full(Dk.size, np.linalg.norm(Dk))]) * 0.1
-        floor = np.maximum(floor, 1e-12)
-        self.scale = np.concatenate([np.ones(self.npole), np.maximum(np.abs(gains), floor)])
-        self.opts, self.seats, self.mu = opts, seats, mu
-        # the set's robust stability (MixedRsBound) and the stage's scalings
-        self.rs, self.rs_scal = rs, None
-        tight = 1.0 - 2 * _MARGIN
-        self.bounds = dict(u=opts.u_bound * tight, x1=opts.z_bound * tight,
-                           mu=opts.mu_max * tight, radius=opts.disk_radius * tight)
-        self.ny = np.asarray(K0.B).shape[1]
-        self._cache: dict = {}
-        self.best: _Point | None = None
-        self.size = 0       # of the constraint vector, set from the start point
-        self.best_y: np.ndarray | None = None
-
-    def controller(self, y: np.ndarray) -> control.StateSpace:
-        x = y * self.scale
-        n, ny = self.n, self.ny
-        A = np.zeros((n, n))
-        i = j = 0
-        for k in self.kinds:
-            if k == 1:
-                A[i, i] = -np.exp(x[j])
-            else:
-                sigma, omega = -np.exp(x[j]), np.exp(x[j + 1])
-                A[i:i + 2, i:i + 2] = [[sigma, omega], [-omega, sigma]]
-            i, j = i + k, j + k
-        B = x[j:j + n * ny].reshape(n, ny)
-        C = x[j + n * ny:j + n * ny + n].reshape(1, n)
-        D = x[j + n * ny + n:].reshape(1, ny)
-        return control.ss(A, B, C, D)
-
-    def rescale(self, y: np.ndarray) -> _Point | None:
-        """Optimise the set's scalings for the controller at ``y`` and forget every
-        evaluation made with the previous ones (their µ figures were other bounds)."""
-        self.rs_scal = self.rs.scalings(self.controller(y))
-        self._cache.clear()
-        self.best = self.best_y = None
-        return self.evaluate(y)
-
-    def evaluate(self, y: np.ndarray) -> _Point | None:
-        key = y.tobytes()
-        if key not in self._cache:
-            p = self._cache[key] = self._evaluate(y)
-            # every evaluated point is a controller with exact figures, SLSQP's iterates
-            # and its difference probes alike: the best one is kept, not the last
-            if p is not None and (self.best is None or p.better_than(self.best)):
-                self.best, self.best_y = p, np.array(y, dtype=float)
-        return self._cache[key]
-
-    def _evaluate(self, y):
-        if not np.all(np.isfinite(y)) or np.any(y[:self.npole] > 50):
-            return None
-        K = self.controller(y)
-        with np.errstate(all="ignore"):
-            try:
-                pa = self.mu.loop_poles(K)
-                covers = [(s.cover, s.cover.loop_poles(K)) for s in self.seats
-                          if s.cover is not None]
-                poles = np.concatenate([loop_poles(K, s.params) for s in self.seats] + [pa]
-                                       + [pc for _, pc in covers])
-                # the set's µ loop: its stability only (its weights' poles are not the
-                # loop's shape)
-                if self.rs is not None and np.max(self.rs.loop_poles(K).real) >= 0:
-                    return None
-            except np.linalg.LinAlgError:
-                return None
-            if not np.all(np.isfinite(poles)) or np.max(poles.real) >= 0:
-                return None             # unstable: neither the FFT nor µ applies
-            peaks = [s.bumpr.peaks(K) for s in self.seats]
-            z = np.concatenate([zs / s.unit for (zs, _, _), s in zip(peaks, self.seats)])
-            u = np.concatenate([p[1] for p in peaks])
-            x1 = np.concatenate([p[2] for p in peaks])
-            if self.opts.mu_performance:
-                curve, top, _ = self.mu.peaks(K, _PEAKS)
-                rp = [curve, top, self.mu.curve(K, _resonance_points(pa))]
-            else:
-                rp = _cover_points(self.mu, K, pa)
-            if self.rs is not None:
-                rp.append(self.rs.levels(K, self.rs_scal))
-            mu = np.concatenate(rp + [g for cover, pc in covers
-                                      for g in _cover_points(cover, K, pc)])
-        b = self.bounds
-        mags = np.sort(np.abs(np.concatenate([poles, np.linalg.eigvals(K.A)])))
-        shape = _shape_margins(poles)
-        violation = max(0.0, float(np.max(u)) / b["u"] - 1, float(np.max(x1)) / b["x1"] - 1,
-                        float(np.max(mu)) / b["mu"] - 1, float(mags[-1]) / b["radius"] - 1,
-                        -float(np.min(shape)))
-        return _Point(z, u, x1, mu, mags, shape, violation)
-
-    def constraints(self, y: np.ndarray) -> np.ndarray:
-        """Normalised margins (>= 0 where met): bump peaks under the epigraph ``t``,
-        force, stroke, µ, pole magnitudes, decay."""
-        t, rest = y[0], y[1:]
-        p = self.evaluate(rest)
-        b = self.bounds
-        if p is None:
-            return -np.ones(self.size)
-        return np.concatenate([(t - p.z) / max(t, 1e-9), 1 - p.u / b["u"],
-                               1 - p.x1 / b["x1"], 1 - p.mu_curve / b["mu"],
-                               1 - p.magnitudes / b["radius"], p.shape])
-
-
-def _slsqp(z0, grad, bounds, constraints, maxiter: int):
-    """One stage's SLSQP: minimise the epigraph variable ``z[0]`` (tests replace it)."""
-    with np.errstate(all="ignore"):
-        return optimize.minimize(lambda v: v[0], z0, jac=lambda v: grad, method="SLSQP",
-                                 bounds=bounds,
-                                 constraints=[{"type": "ineq", "fun": constraints}],
-                                 options={"maxiter": maxiter, "ftol": 1e-6})
-
-
-@dataclass(frozen=True)
 class RefineStage:
     """One trust-region stage of :func:`refine_seat_controller` (progress record).
 
@@ -843,6 +343,9 @@ class RefinedDesign:
         With ``options.occupants``: the set's robust-stability µ of ``K`` over every
         frequency, with scalings optimised for ``K`` itself (``met`` judged the search's
         scalings, found for the last stage's start); nan without.
+    certificate : SystuneResult
+        ``systune``'s result: each requirement recomputed on ``K`` by another route
+        (:meth:`~.goals.SeatLoops.certified`: time simulation, ``mussv``, ``eigvals``).
     """
 
     K: control.StateSpace
@@ -858,6 +361,7 @@ class RefinedDesign:
     iterations: int
     seconds: float
     rs_sup: float = float("nan")
+    certificate: object = None
 
 
 def _seats(opts: RefineOptions, design: SeatDesignOptions, params, road) -> list:
@@ -867,14 +371,80 @@ def _seats(opts: RefineOptions, design: SeatDesignOptions, params, road) -> list
     road = bump() if road is None else road
     delays = tuple(opts.delays)
     if not opts.plants:
-        return [_Seat(BumpResponse(road=road, delays=delays, params=params), 1.0, params,
-                      None)]
+        return [SeatSeat(BumpResponse(road=road, delays=delays, params=params), 1.0, params,
+                         None)]
     seats = []
     for k, p in enumerate((params,) + opts.plants):
         limit = bump_limit(road, p, dt=_LIMIT_DT).certified_peak
-        seats.append(_Seat(BumpResponse(road=road, delays=delays, params=p), float(limit),
-                           p, None if k == 0 else TwoBlockMu(design, _MU_GRID, p)))
+        seats.append(SeatSeat(BumpResponse(road=road, delays=delays, params=p), float(limit),
+                              p, None if k == 0 else TwoBlockMu(design, _MU_GRID, p)))
     return seats
+
+
+def _refine_on_tune(start, opts: RefineOptions, design, params, road, callback, t_start):
+    """The refinement as :func:`~lmi_suspension.tune.systune`'s SLSQP route over the
+    seat's requirements (:mod:`.goals`) on the modal block
+    (:func:`~lmi_suspension.tune.tunable_modal`)."""
+    from ..tune import SystuneOptions, TrustRegionOptions, systune, tunable_modal
+    from .augmented import seat_augmented_plant
+
+    rs = None
+    if opts.occupants is not None:
+        from .occupants import MixedRsBound
+
+        rs = MixedRsBound(opts.occupants, design)
+    loops = SeatLoops(_seats(opts, design, params, road),
+                      TwoBlockMu(design, _MU_GRID, params), opts.mu_performance, rs)
+    unstable = ParameterError("K0's loop (residualised to the disk) is not stable")
+    if not loops.stable(start):
+        raise unstable      # checked here, not left to the engine, to name K0
+    block = tunable_modal("K", start, pole_bounds=(1e-3, opts.disk_radius))
+    aug = seat_augmented_plant(design, params)
+    soft = [BumpPeak(loops)]
+    hard = [BumpForce(loops, opts.u_bound), BumpStroke(loops, opts.z_bound),
+            MuBound(loops, opts.mu_max), PoleDisk(loops, opts.disk_radius), PoleShape(loops)]
+    trust = TrustRegionOptions(max_iter=opts.max_iter,
+                               stage_iter=_STAGE_ITER if rs is None else _RS_STAGE_ITER,
+                               trust_start=_TRUST_START if rs is None else _RS_TRUST_START,
+                               trust_min=_TRUST_MIN, margin=_MARGIN)
+    stages = []
+
+    def on_stage(rec):
+        f = loops.figures_at(rec.theta)
+        stage = RefineStage(index=rec.index, iterations=rec.iterations, trust=rec.trust,
+                            accepted=rec.accepted, peak=rec.soft,
+                            u_peak=float(np.max(f.u)), x1_peak=float(np.max(f.x1)),
+                            mu=float(np.max(f.mu_curve)), radius=float(f.magnitudes[-1]),
+                            violation=rec.violation, seconds=rec.seconds,
+                            rs_sup=float("nan") if rs is None else loops.rs_scal.sup)
+        stages.append(stage)
+        logger.info("refine stage %d: %s, peak %.3f m/s², |u| %.0f N, µ %.4f, radius %.0f, "
+                    "violation %.2g (%d iterations, %.1f s)", stage.index,
+                    "accepted" if stage.accepted else "rejected", stage.peak,
+                    stage.u_peak, stage.mu, stage.radius, stage.violation,
+                    stage.iterations, stage.seconds)
+        if callback is not None:
+            callback(stage)
+
+    res = systune(aug.P, block, soft=soft, hard=hard, nmeas=aug.nmeas, ncon=aug.ncon,
+                  options=SystuneOptions(method="slsqp", trust_region=trust,
+                                         on_unstable="return"),
+                  callback=on_stage)
+    if not np.isfinite(res.starts[0].soft):
+        raise unstable
+    theta = res.theta
+    best = loops.figures_at(theta)
+    K = block.ss(theta)
+    K = control.ss(K.A, K.B, K.C, K.D, inputs=["x1", "x3"], outputs=["u"], name="K_refined")
+    rs_sup = float("nan") if rs is None else loops.certified(res.K[0])["rs_sup"]
+    per_delay = (lambda v: np.max(v.reshape(len(loops.seats), -1), axis=0))
+    return RefinedDesign(K=K, K0=start, peak=per_delay(best.z), u_peak=per_delay(best.u),
+                         x1_peak=per_delay(best.x1), mu=float(np.max(best.mu_curve)),
+                         radius=float(best.magnitudes[-1]),
+                         met=res.starts[0].hard - 1.0 <= _MARGIN, options=opts,
+                         stages=tuple(stages), iterations=res.starts[0].iterations,
+                         seconds=time.perf_counter() - t_start, rs_sup=rs_sup,
+                         certificate=res)
 
 
 def refine_seat_controller(K0, options: RefineOptions | None = None, *,
@@ -885,8 +455,10 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
     delays, subject to exact force, stroke, µ and pole requirements.
 
     The controller keeps its order (after its poles outside ``options.disk_radius``
-    are residualised); its real modal realization (:func:`modal_form`) is searched by
-    SLSQP in trust-region stages (a box around the stage's start in normalised
+    are residualised); its real modal realization (:func:`modal_form`, tuned as
+    :func:`~lmi_suspension.tune.tunable_modal`) is searched by
+    :func:`~lmi_suspension.tune.systune`'s SLSQP route against the requirements of
+    :mod:`.goals`: trust-region stages (a box around the stage's start in normalised
     parameters, halved where a stage does not improve).  A stage's result is kept only
     if it is better: less violation of the requirements, or, once they are met, a lower
     peak.  Every figure is exact (see the module docstring), so the answer is a local
@@ -898,7 +470,7 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
         Start controller ``y = [x1, x3] -> u`` whose loop is stable (the µ design's).
     options : RefineOptions, optional
     design : SeatDesignOptions, optional
-        The µ weights and delay cover (:data:`~.design.DEFAULT_DESIGN` by default).
+        The µ weights and delay cover (:data:`~.augmented.DEFAULT_DESIGN` by default).
     params : SeatParameters, optional
     road : RoadInput, optional
         The paper's bump by default.
@@ -915,8 +487,6 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
         ``K0`` not a two-input, one-output continuous-time controller, or its loop
         unstable.
     """
-    from .design import DEFAULT_DESIGN
-
     t_start = time.perf_counter()
     opts = RefineOptions() if options is None else options
     if not isinstance(opts, RefineOptions):
@@ -931,80 +501,7 @@ def refine_seat_controller(K0, options: RefineOptions | None = None, *,
             raise ParameterError("K0 has non-finite entries")
     start = modal_form(K0, radius=opts.disk_radius)
     design = DEFAULT_DESIGN if design is None else design
-    rs = None
-    if opts.occupants is not None:
-        from .occupants import MixedRsBound
-
-        rs = MixedRsBound(opts.occupants, design)
-    prob = _Problem(start, opts, _seats(opts, design, params, road),
-                    TwoBlockMu(design, _MU_GRID, params), rs)
-    y = prob.x0 / prob.scale
-    unstable = ParameterError("K0's loop (residualised to the disk) is not stable")
-    if rs is not None:
-        # checked here, not left to MixedRsBound.scalings, to name K0 in the error
-        if np.max(rs.loop_poles(prob.controller(y)).real) >= 0:
-            raise unstable
-        best = prob.rescale(y)
-    else:
-        best = prob.evaluate(y)
-    if best is None:
-        raise unstable
-    prob.size = prob.constraints(np.concatenate([[best.objective], y])).size
-    lower = np.full(y.size, -np.inf)
-    upper = np.full(y.size, np.inf)
-    lower[:prob.npole] = np.log(1e-3)
-    upper[:prob.npole] = np.log(opts.disk_radius)
-    trust, iterations, stages = (_TRUST_START if rs is None else _RS_TRUST_START), 0, []
-    stage_iter = _STAGE_ITER if rs is None else _RS_STAGE_ITER
-    while iterations < opts.max_iter and trust >= _TRUST_MIN:
-        t0 = time.perf_counter()
-        if rs is not None and stages and stages[-1].accepted:
-            # the D-step of the alternation: scalings for the stage's start (after a
-            # rejected stage the start, and so its scalings, are the same).  The start's
-            # figures may rise with them: new split points can hold a peak the last missed
-            best = prob.rescale(y)
-            logger.info("refine stage %d: the set's robust-stability µ %.4f over every "
-                        "frequency at its start", len(stages) + 1, prob.rs_scal.sup)
-        # the epigraph variable t first: minimise t with every peak below it
-        z0 = np.concatenate([[best.objective], y])
-        lo = np.concatenate([[0.0], np.maximum(lower, y - trust)])
-        hi = np.concatenate([[np.inf], np.minimum(upper, y + trust)])
-        grad = np.zeros(z0.size)
-        grad[0] = 1.0
-        res = _slsqp(z0, grad, list(zip(lo, hi)), prob.constraints,
-                     min(stage_iter, opts.max_iter - iterations))
-        iterations += int(res.nit)
-        prob.evaluate(np.clip(res.x[1:], np.maximum(lower, y - trust),
-                              np.minimum(upper, y + trust)))
-        accepted = prob.best is not best
-        if accepted:
-            y, best = prob.best_y, prob.best
-        else:
-            trust /= 2
-        rec = RefineStage(index=len(stages) + 1, iterations=int(res.nit), trust=trust,
-                          accepted=accepted, peak=best.objective,
-                          u_peak=float(np.max(best.u)), x1_peak=float(np.max(best.x1)),
-                          mu=best.mu, radius=best.radius, violation=best.violation,
-                          seconds=time.perf_counter() - t0,
-                          rs_sup=float("nan") if rs is None else prob.rs_scal.sup)
-        stages.append(rec)
-        logger.info("refine stage %d: %s, peak %.3f m/s², |u| %.0f N, µ %.4f, radius %.0f, "
-                    "violation %.2g (%d iterations, %.1f s)", rec.index,
-                    "accepted" if accepted else "rejected", rec.peak, rec.u_peak, rec.mu,
-                    rec.radius, rec.violation, rec.iterations, rec.seconds)
-        if callback is not None:
-            callback(rec)
-        if accepted and best.violation <= _MARGIN and res.success and res.nit < stage_iter:
-            break        # SLSQP converged inside the box: a local optimum
-    K = prob.controller(y)
-    K = control.ss(K.A, K.B, K.C, K.D, inputs=["x1", "x3"], outputs=["u"], name="K_refined")
-    rs_sup = float("nan") if rs is None else rs.scalings(K).sup
-    per_delay = (lambda v: np.max(v.reshape(len(prob.seats), -1), axis=0))
-    return RefinedDesign(K=K, K0=start, peak=per_delay(best.z), u_peak=per_delay(best.u),
-                         x1_peak=per_delay(best.x1),
-                         mu=best.mu, radius=best.radius, met=best.violation <= _MARGIN,
-                         options=opts, stages=tuple(stages), iterations=iterations,
-                         seconds=time.perf_counter() - t_start, rs_sup=rs_sup)
+    return _refine_on_tune(start, opts, design, params, road, callback, t_start)
 
 
 # ----------------------------------------------------------------------------- certificate
@@ -1025,7 +522,7 @@ def certify_refined(K, *, Kd=None, delays=REFINE_DELAYS, design: SeatDesignOptio
     :func:`~lmi_suspension.mu.mussv` on a dense grid (not the search's two-block
     formula), the 1 kHz sampled-data loop and the delay margin.
 
-    The certificate of every seat route, :func:`~.routes.certify_seat`, with the
+    The certificate of every seat route, :func:`~.record.certify_seat`, with the
     refinement's delays.
 
     Parameters
@@ -1035,7 +532,7 @@ def certify_refined(K, *, Kd=None, delays=REFINE_DELAYS, design: SeatDesignOptio
         Its discrete realization (Tustin at 1 kHz by default).
     delays : sequence of float
     design : SeatDesignOptions, optional
-        µ weights (:data:`~.design.DEFAULT_DESIGN` by default).
+        µ weights (:data:`~.augmented.DEFAULT_DESIGN` by default).
     params : SeatParameters, optional
     rng : numpy.random.Generator, optional
         Seeds the µ lower bound.
@@ -1044,7 +541,7 @@ def certify_refined(K, *, Kd=None, delays=REFINE_DELAYS, design: SeatDesignOptio
     -------
     SeatCertificate
     """
-    from .routes import certify_seat
+    from .record import certify_seat
 
     return certify_seat(K, Kd=Kd, delays=delays, design=design, params=params, rng=rng)
 
@@ -1094,9 +591,10 @@ def _start(start, params, rng, progress) -> control.StateSpace:
     """The start controller of a refinement route: given, or designed along a route."""
     if isinstance(start, control.StateSpace):
         return start
-    from .routes import design_seat
-
-    return design_seat(start, params=params, rng=rng, progress=progress).K
+    if not hasattr(start, "design"):
+        raise ParameterError(f"start must be a control.StateSpace or a seat route, got "
+                             f"{type(start).__name__}")
+    return start.design(params, rng=rng, progress=progress).K
 
 
 def _stage_line(rec: RefineStage) -> str:
@@ -1120,7 +618,7 @@ class RefineRoute:
         with ``design_options`` by default).
     design_options : SeatDesignOptions, optional
         The µ weights and delay cover of the requirements
-        (:data:`~.design.DEFAULT_DESIGN` by default).
+        (:data:`~.augmented.DEFAULT_DESIGN` by default).
 
     Examples
     --------
@@ -1136,8 +634,8 @@ class RefineRoute:
     def design(self, params: SeatParameters, *, rng: np.random.Generator, progress=None):
         """The start (given or designed), refined at ``params``; the search draws
         nothing at random, so ``rng`` reaches the start's route alone."""
-        from .design import DEFAULT_DESIGN, MuRoute
-        from .routes import seat_design_from
+        from .design import MuRoute
+        from .record import seat_design_from
 
         weights = DEFAULT_DESIGN if self.design_options is None else self.design_options
         start = MuRoute(design_options=weights) if self.start is None else self.start

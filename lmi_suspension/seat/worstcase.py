@@ -11,7 +11,7 @@ multi-seat design of 2026-11-27, 200 samples read 1559 N at worst where the set'
 road requirements: it meets the controller at every corner of the set's box and at
 Latin-hypercube samples, then climbs from the worst few by bounded quasi-Newton steps
 (L-BFGS-B, finite differences, inside the box), ranking seats by the closed-form
-frequency-domain figures of :class:`~.refine.BumpResponse`; the worst seat's figure is
+frequency-domain figures of :class:`~.loop.BumpResponse`; the worst seat's figure is
 then the exact-delay time simulation's, a route the ranking does not use.  What it
 returns is a *lower bound* on the set's worst figure, attained at a seat it names: a
 search, not a proof; a figure above a bound is a violation.  A seat where the loop is
@@ -167,7 +167,7 @@ def worst_bump_seats(K, occupants: OccupantSet | None = None, *, rng: np.random.
     """
     from scipy.optimize import minimize
 
-    from .refine import REFINE_DELAYS, BumpResponse, loop_poles
+    from .loop import REFINE_DELAYS, BumpResponse, loop_poles
     from .simulate import closed_loop_stable, simulate
 
     if not isinstance(K, control.StateSpace) or K.isdtime(strict=True) \

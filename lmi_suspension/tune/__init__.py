@@ -9,16 +9,28 @@
 * Requirements behind one protocol (:mod:`~lmi_suspension.tune.requirements`: an H∞
   bound on a weighted channel, a pole region, disk margins) and :func:`systune`, which
   minimises the soft ones subject to the hard ones over several models, every value
-  recomputed on the returned controller.
+  recomputed on the returned controller; its SLSQP route
+  (:mod:`~lmi_suspension.tune.stages`, trust-region stages on the epigraph form) for
+  requirements that give every term of their maximum, with :func:`tunable_modal`, a
+  stable modal block in normalised parameters, to refine a given controller (the
+  seat's refinement runs on it).
 
 This package sits above :mod:`lmi_suspension.lti` and :mod:`lmi_suspension.synthesis`;
 neither imports it.
 """
 
-from .blocks import TunableBlock, block_diagonal, tunable_gain, tunable_pid, tunable_ss
+from .blocks import (
+                     TunableBlock,
+                     block_diagonal,
+                     tunable_gain,
+                     tunable_modal,
+                     tunable_pid,
+                     tunable_ss,
+)
 from .closedloop import ClosedLoop
 from .hinfstruct import HinfstructOptions, HinfstructResult, StartRecord, hinfstruct
 from .requirements import HinfBound, Margins, PoleRegion, Requirement
+from .stages import TrustRegionOptions, TrustRegionStage, trust_region_slsqp
 from .surface import GainSurface, ScheduledBlock, tunable_surface
 from .systune import SystuneOptions, SystuneResult, SystuneStart, systune
 
@@ -36,11 +48,15 @@ __all__ = [
     "SystuneOptions",
     "SystuneResult",
     "SystuneStart",
+    "TrustRegionOptions",
+    "TrustRegionStage",
     "TunableBlock",
     "block_diagonal",
     "hinfstruct",
     "systune",
+    "trust_region_slsqp",
     "tunable_gain",
+    "tunable_modal",
     "tunable_pid",
     "tunable_ss",
     "tunable_surface",

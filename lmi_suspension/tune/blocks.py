@@ -38,7 +38,8 @@ import numpy as np
 from ..errors import DimensionError, InputError, NonFiniteError, ParameterError
 from ..lti.checks import finite_scalar
 
-__all__ = ["TunableBlock", "tunable_gain", "tunable_pid", "tunable_ss", "block_diagonal"]
+__all__ = ["TunableBlock", "tunable_gain", "tunable_pid", "tunable_ss", "tunable_modal",
+           "block_diagonal"]
 
 
 @runtime_checkable
@@ -600,6 +601,163 @@ def tunable_ss(name: str, order: int, ny: int, nu: int, *, start=None, fixed=Non
     True
     """
     return _StateSpace(name, order, ny, nu, start=start, fixed=fixed)
+
+
+# --------------------------------------------------------------------------- stable modal
+def _modal_kinds(A) -> list:
+    """The block pattern (1: ``[a]``, 2: ``[[σ, ω], [-ω, σ]]``) of a real modal ``A``."""
+    n, kinds, i = A.shape[0], [], 0
+    while i < n:
+        k = 2 if i + 1 < n and A[i, i + 1] != 0.0 else 1
+        kinds.append(k)
+        i += k
+    return kinds
+
+
+class _StableModal(_Block):
+    kind = "tunable stable modal state space"
+
+    def __init__(self, name, start, *, pole_bounds=None):
+        if not isinstance(start, control.StateSpace) or not start.isctime():
+            raise ParameterError("tunable_modal needs a continuous-time StateSpace start")
+        A, B, C, D = (np.atleast_2d(np.asarray(M, dtype=float))
+                      for M in (start.A, start.B, start.C, start.D))
+        n, no, ni = A.shape[0], D.shape[0], D.shape[1]
+        if not all(np.all(np.isfinite(M)) for M in (A, B, C, D)):
+            raise NonFiniteError("the start controller holds NaN or infinity")
+        kinds = _modal_kinds(A)
+        expect, labels, poles, i = np.zeros_like(A), [], [], 0
+        for k in kinds:
+            if k == 1:
+                expect[i, i] = A[i, i]
+                labels.append(f"ln(-a[{i}])")
+                poles.append(-A[i, i])
+            else:
+                sigma, omega = A[i, i], A[i, i + 1]
+                expect[i:i + 2, i:i + 2] = [[sigma, omega], [-omega, sigma]]
+                labels += [f"ln(-sigma[{i}])", f"ln(omega[{i}])"]
+                poles += [-sigma, omega]
+            i += k
+        if not np.array_equal(A, expect) or not np.all(np.asarray(poles) > 0):
+            raise ParameterError("tunable_modal needs a stable real modal start: 1 x 1 "
+                                 "blocks [a], a < 0, and 2 x 2 blocks [[s, w], [-w, s]], s < "
+                                 "0 < w (seat.refine.modal_form gives one)")
+        self._kinds, self.n_poles = kinds, len(poles)
+        labels += [f"B[{r},{c}]" for r in range(n) for c in range(ni)]
+        labels += [f"C[{r},{c}]" for r in range(no) for c in range(n)]
+        labels += [f"D[{r},{c}]" for r in range(no) for c in range(ni)]
+        gains = np.concatenate([B.ravel(), C.ravel(), D.ravel()])
+        # each gain in units of its own magnitude; an entry that is zero (a rotated pair's
+        # second output gain) in a tenth of its mode's
+        mode = np.sqrt(np.sum(B ** 2, axis=1) + np.sum(C ** 2, axis=0))
+        floor = np.concatenate([np.repeat(mode, ni), np.tile(mode, no),
+                                np.full(D.size, np.linalg.norm(D))]) * 0.1
+        floor = np.maximum(floor, 1e-12)
+        self._scale = np.concatenate([np.ones(self.n_poles), np.maximum(np.abs(gains), floor)])
+        # one logarithm at a time, as a scalar: the seat's shipped refinement was started so
+        x0 = np.concatenate([[np.log(v) for v in poles], gains])
+        super().__init__(name, no, ni, n, labels, x0 / self._scale)
+        self.lower = np.full(self.n_params, -np.inf)
+        self.upper = np.full(self.n_params, np.inf)
+        if pole_bounds is not None:
+            lo, hi = pole_bounds
+            if not (0 < float(lo) < float(hi) < np.inf):
+                raise ParameterError(f"pole_bounds must be 0 < low < high < inf, got "
+                                     f"{pole_bounds!r}")
+            self.lower[:self.n_poles] = np.log(float(lo))
+            self.upper[:self.n_poles] = np.log(float(hi))
+
+    def _full_matrices(self, p):
+        x = p * self._scale
+        n, ny, nu = self.nstates, self.noutputs, self.ninputs
+        A = np.zeros((n, n))
+        i = j = 0
+        for k in self._kinds:
+            if k == 1:
+                A[i, i] = -np.exp(x[j])
+            else:
+                sigma, omega = -np.exp(x[j]), np.exp(x[j + 1])
+                A[i:i + 2, i:i + 2] = [[sigma, omega], [-omega, sigma]]
+            i, j = i + k, j + k
+        B = x[j:j + n * nu].reshape(n, nu)
+        C = x[j + n * nu:j + n * nu + ny * n].reshape(ny, n)
+        D = x[j + n * nu + ny * n:].reshape(ny, nu)
+        return A, B, C, D
+
+    def _full_jacobian(self, p):
+        x = p * self._scale
+        n, ny, nu = self.nstates, self.noutputs, self.ninputs
+        J = np.zeros((p.size, ny + n, nu + n))
+        i = j = 0
+        for k in self._kinds:            # A sits at rows ny + i, columns nu + i
+            if k == 1:
+                J[j, ny + i, nu + i] = -np.exp(x[j])
+            else:
+                J[j, ny + i, nu + i] = J[j, ny + i + 1, nu + i + 1] = -np.exp(x[j])
+                J[j + 1, ny + i, nu + i + 1] = np.exp(x[j + 1])
+                J[j + 1, ny + i + 1, nu + i] = -np.exp(x[j + 1])
+            i, j = i + k, j + k
+        for r in range(n):               # B
+            for c in range(nu):
+                J[j, ny + r, c] = self._scale[j]
+                j += 1
+        for r in range(ny):              # C
+            for c in range(n):
+                J[j, r, nu + c] = self._scale[j]
+                j += 1
+        for r in range(ny):              # D
+            for c in range(nu):
+                J[j, r, c] = self._scale[j]
+                j += 1
+        return J
+
+
+def tunable_modal(name: str, start: control.StateSpace, *, pole_bounds=None):
+    """A tunable state-space block in stable real modal form, in normalised parameters.
+
+    ``A`` is block diagonal with blocks ``[a]`` and ``[[σ, ω], [-ω, σ]]``, parametrised by
+    ``ln(-a)``, ``ln(-σ)`` and ``ln ω``, so every parameter value gives a stable block
+    with the start's pattern of real poles and pairs; ``B``, ``C`` and ``D`` are free,
+    each entry in units of its start's magnitude (an entry that starts at zero in a tenth
+    of its mode's gain), so that a step of 0.1 in any parameter moves any gain by about
+    10 % and any pole by a factor ``e^0.1``: one trust region suits all parameters (the
+    seat's refinement, :func:`~lmi_suspension.seat.refine.refine_seat_controller`,
+    tunes its controller so).  Use it to refine a given controller; :func:`tunable_ss`
+    to search from scratch.
+
+    Parameters
+    ----------
+    name : str
+    start : control.StateSpace
+        A continuous-time controller in stable real modal form (its ``A`` exactly of the
+        block pattern above, e.g. from :func:`~lmi_suspension.seat.refine.modal_form`);
+        one without states gives a static gain in the same units.
+    pole_bounds : (float, float), optional
+        Every pole parameter (``-a``, ``-σ``, ``ω``) within ``[low, high]``, rad/s:
+        the block's ``lower`` and ``upper`` bounds, which the SLSQP route of
+        :func:`~lmi_suspension.tune.systune` respects.
+
+    Returns
+    -------
+    TunableBlock
+        Also with ``n_poles`` (the pole parameters come first), ``lower`` and ``upper``.
+
+    Raises
+    ------
+    ParameterError, NonFiniteError
+        A start not in stable real modal form, or with non-finite entries.
+
+    Examples
+    --------
+    >>> import control
+    >>> K0 = control.ss([[-1.0, 2.0], [-2.0, -1.0]], [[1.0], [0.5]], [[3.0, 0.0]], [[0.0]])
+    >>> K = tunable_modal("K", K0)
+    >>> K.param_names[:2], K.n_poles
+    (('K.ln(-sigma[0])', 'K.ln(omega[0])'), 2)
+    >>> bool(np.allclose(K.ss(K.start).A, K0.A))
+    True
+    """
+    return _StableModal(name, start, pole_bounds=pole_bounds)
 
 
 # --------------------------------------------------------------------------- block diagonal

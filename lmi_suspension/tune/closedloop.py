@@ -41,7 +41,7 @@ class ClosedLoop:
     Attributes
     ----------
     theta : numpy.ndarray
-        The blocks' free parameters.
+        The blocks' free parameters (:attr:`controller` is the controller there).
     A, B, C, D : numpy.ndarray
         The closed loop from ``w`` to ``z``, states ``[x_P; x_K]``.
     plant : GeneralizedPlant
@@ -88,6 +88,18 @@ class ClosedLoop:
     @property
     def n_params(self) -> int:
         return self._J.shape[0]
+
+    @property
+    def block(self):
+        """The tunable block (all the model's blocks as one)."""
+        return self._loop.block
+
+    @property
+    def controller(self) -> control.StateSpace:
+        """The controller at ``theta``, for a requirement evaluated on the controller
+        itself (its poles, as MATLAB's ``TuningGoal.ControllerPoles``) or on a model no
+        finite plant holds (an exact delay)."""
+        return self._loop.block.ss(self.theta)
 
     @property
     def ss(self) -> control.StateSpace:

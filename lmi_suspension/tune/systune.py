@@ -38,6 +38,16 @@ that stabilises every model (BFGS on the largest spectral abscissa over the mode
 ``hinfstruct`` does for one), from the blocks' start and ``starts - 1`` random
 perturbations of it drawn from the seeded ``Generator``.
 
+**The SLSQP route** (``SystuneOptions(method="slsqp")``, :mod:`~lmi_suspension.tune.stages`):
+for requirements that give every term of their maximum (a method ``terms(loop)`` for a
+soft one, ``margins(loop, tighten)`` for a hard one; any other requirement counts as its
+value alone), SLSQP in trust-region stages on the epigraph form, with finite-difference
+Jacobians, from the first start only, which must stabilise every model (no
+stabilisation phase), within the blocks' ``lower``/``upper`` bounds where they have them.
+A requirement with a method ``refresh(loop)`` refreshes what it holds fixed through a stage
+at each accepted stage's start.  The seat's refinement
+(:func:`~lmi_suspension.seat.refine.refine_seat_controller`) runs on it.
+
 The result is certified: every requirement is recomputed on ``lft(P_m, K_m)`` of the
 returned numbers by its ``certify`` (``hinfnorm`` with a dense σ̄ sweep,
 ``numpy.linalg.eigvals``, a sensitivity built by ``control.feedback``); ``feasible`` and
@@ -61,6 +71,7 @@ from ..lti.plant import lft
 from .blocks import block_diagonal
 from .closedloop import ClosedLoop
 from .hinfstruct import _bfgs, _Loop, _plant, _starts
+from .stages import TrustRegionOptions, trust_region_slsqp
 
 __all__ = ["SystuneOptions", "SystuneResult", "SystuneStart", "systune"]
 
@@ -103,6 +114,11 @@ class SystuneOptions:
         No start stabilised every model: raise
         :class:`~lmi_suspension.errors.IterationLimitError`, or return a result that
         says so.
+    method : {"bfgs", "slsqp"}
+        The nonsmooth BFGS with the progress function, or SLSQP in trust-region stages
+        (module docstring; ``max_iter`` and the other BFGS options do not apply to it).
+    trust_region : TrustRegionOptions, optional
+        The SLSQP route's options (its defaults when omitted).
     """
 
     max_iter: int = 300
@@ -112,6 +128,8 @@ class SystuneOptions:
     stall_iter: int = 10
     perturbation: float = 0.5
     on_unstable: str = "raise"
+    method: str = "bfgs"
+    trust_region: TrustRegionOptions | None = None
 
     def __post_init__(self):
         for name in ("max_iter", "max_outer", "stab_max_iter", "stall_iter"):
@@ -125,6 +143,12 @@ class SystuneOptions:
         if self.on_unstable not in ("raise", "return"):
             raise ParameterError(f"on_unstable must be 'raise' or 'return', got "
                                  f"{self.on_unstable!r}")
+        if self.method not in ("bfgs", "slsqp"):
+            raise ParameterError(f"method must be 'bfgs' or 'slsqp', got {self.method!r}")
+        if self.trust_region is not None and not isinstance(self.trust_region,
+                                                            TrustRegionOptions):
+            raise ParameterError(f"trust_region must be TrustRegionOptions, got "
+                                 f"{type(self.trust_region).__name__}")
 
 
 @dataclass(frozen=True)
@@ -181,6 +205,8 @@ class SystuneResult:
     warnings : tuple of str
         What was asked and not obtained (a hard requirement not met, no stabilising
         point, a best start stopped by its iteration bound).
+    stages : tuple of TrustRegionStage
+        The SLSQP route's stages (empty for BFGS).
     """
 
     values: dict
@@ -198,6 +224,7 @@ class SystuneResult:
     best: int = 0
     seconds: float = 0.0
     warnings: tuple = field(default_factory=tuple)
+    stages: tuple = ()
 
 
 # ------------------------------------------------------------------------------ inputs
@@ -433,11 +460,102 @@ def _progress(prob: _Problem, z, opts):
     return z, used, outer, why
 
 
+# ------------------------------------------------------------------------------ SLSQP
+def _soft_terms(r, cl):
+    if hasattr(r, "terms"):
+        out = r.terms(cl)
+        return None if out is None else np.atleast_1d(np.asarray(out, dtype=float))
+    v, _ = r.value(cl)
+    return np.array([float(v)]) if np.isfinite(v) else None
+
+
+def _hard_margins(r, cl, tighten):
+    if hasattr(r, "margins"):
+        out = r.margins(cl, tighten)
+        return None if out is None else np.atleast_1d(np.asarray(out, dtype=float))
+    v, _ = r.value(cl)
+    return np.array([1.0 - float(v) / tighten]) if np.isfinite(v) else None
+
+
+def _closed_loops(prob: _Problem, theta):
+    closed = []
+    for loop in prob.loops:
+        try:
+            cl = ClosedLoop(loop, theta)
+        except (np.linalg.LinAlgError, IllPosedLoopError):
+            return None
+        if not cl.stable:
+            return None
+        closed.append(cl)
+    return closed
+
+
+def _run_slsqp(prob: _Problem, theta0, opts: SystuneOptions, callback):
+    """The SLSQP route from ``theta0`` (module docstring): ``(SystuneStart, stages)``."""
+    t0, n0 = time.perf_counter(), prob.evaluations
+    tr = TrustRegionOptions() if opts.trust_region is None else opts.trust_region
+    block = prob.loops[0].block
+    positive = prob.loops[0].positive
+
+    def evaluate(z):
+        prob.evaluations += 1
+        theta = prob.theta(z)
+        if not np.all(np.isfinite(theta)):
+            return None
+        closed = _closed_loops(prob, theta)
+        if closed is None:
+            return None
+        soft, margins = [], []
+        for out, reqs, terms in ((soft, prob.soft, _soft_terms),
+                                 (margins, prob.hard, _hard_margins)):
+            for cl, model_reqs in zip(closed, reqs):
+                for r in model_reqs:
+                    v = terms(r, cl) if terms is _soft_terms else terms(r, cl, tr.tighten)
+                    if v is None:
+                        return None
+                    out.append(v)
+        return (np.concatenate(soft) if soft else np.zeros(1),
+                np.concatenate(margins) if margins else np.zeros(0))
+
+    fresh = [r for reqs in prob.soft + prob.hard for r in reqs if hasattr(r, "refresh")]
+
+    def refresh(z):
+        closed = _closed_loops(prob, prob.theta(z))
+        if closed is None:
+            raise ParameterError("the loop is unstable where the requirements refresh")
+        for cl, reqs in zip(closed, [s + h for s, h in zip(prob.soft, prob.hard)]):
+            for r in reqs:
+                if hasattr(r, "refresh"):
+                    r.refresh(cl)
+
+    with np.errstate(divide="ignore", invalid="ignore"):
+        bound = (lambda name, fill: np.where(
+            positive, np.log(np.maximum(getattr(block, name, fill), 0.0)),
+            getattr(block, name, fill)) * np.ones(block.n_params))
+        lower, upper = bound("lower", -np.inf), bound("upper", np.inf)
+    try:
+        z, soft, violation, stages, it = trust_region_slsqp(
+            evaluate, prob.z(theta0), tr, lower=lower, upper=upper,
+            refresh=refresh if fresh else None, callback=callback)
+    except ParameterError as exc:
+        logger.info("SLSQP route: %s", exc)
+        return SystuneStart(0, theta0, theta0.copy(), np.inf, np.inf, 0, 0, 0,
+                            f"not stabilised: {exc}", time.perf_counter() - t0,
+                            prob.evaluations - n0), ()
+    why = ("converged in a stage" if stages and stages[-1].iterations < tr.stage_iter
+           and stages[-1].accepted else "iteration bound" if it >= tr.max_iter
+           else "trust region below its minimum")
+    logger.info("SLSQP route: soft %.6g, violation %.2g after %d iterations in %d stages "
+                "(%s)", soft, violation, it, len(stages), why)
+    return SystuneStart(0, theta0, prob.theta(z), soft, 1.0 + violation, 0, it, len(stages),
+                        why, time.perf_counter() - t0, prob.evaluations - n0), stages
+
+
 # ------------------------------------------------------------------------------ systune
 def systune(models, blocks, soft=(), hard=(), *, nmeas: int | None = None,
             ncon: int | None = None, starts=1,
             rng: np.random.Generator | None = None,
-            options: SystuneOptions | None = None) -> SystuneResult:
+            options: SystuneOptions | None = None, callback=None) -> SystuneResult:
     """Tune the blocks against soft and hard requirements over several models.
 
     Parameters
@@ -461,6 +579,10 @@ def systune(models, blocks, soft=(), hard=(), *, nmeas: int | None = None,
     rng : numpy.random.Generator, optional
         Source of the random starts (``default_rng(0)`` when omitted).
     options : SystuneOptions, optional
+    callback : callable, optional
+        The SLSQP route calls it with each
+        :class:`~lmi_suspension.tune.stages.TrustRegionStage` (progress); the BFGS route
+        with each start's :class:`SystuneStart`.
 
     Returns
     -------
@@ -516,11 +638,19 @@ def systune(models, blocks, soft=(), hard=(), *, nmeas: int | None = None,
     points = _starts(model_blocks[0], starts, rng, opts)
     prob = _Problem([_Loop(G, b) for G, b in zip(plants, model_blocks)], soft_b, hard_b)
 
-    records = [_run_start(prob, k, t, opts, bool(soft_reqs), bool(hard_reqs))
-               for k, t in enumerate(points)]
+    stages = ()
+    if opts.method == "slsqp":
+        record, stages = _run_slsqp(prob, points[0], opts, callback)
+        records = [record]
+    else:
+        records = []
+        for k, t in enumerate(points):
+            records.append(_run_start(prob, k, t, opts, bool(soft_reqs), bool(hard_reqs)))
+            if callback is not None:
+                callback(records[-1])
     best, warnings = _choose(records, opts)
     return _certified(plants, model_blocks, soft_b, hard_b, best, records, warnings,
-                      t_start, opts)
+                      t_start, opts, stages)
 
 
 def _choose(records, opts):
@@ -553,7 +683,7 @@ def _each_block(block, theta) -> dict:
 
 
 def _certified(plants, model_blocks, soft_b, hard_b, best, records, warnings, t_start,
-               opts) -> SystuneResult:
+               opts, stages=()) -> SystuneResult:
     theta = best.theta
     Ks, CLs, stable = [], [], True
     soft_v = np.full((len(plants), len(soft_b[0])), np.inf)
@@ -586,4 +716,4 @@ def _certified(plants, model_blocks, soft_b, hard_b, best, records, warnings, t_
         soft=float(soft_v.max()) if soft_v.size else 0.0, hard=hard,
         soft_values=soft_v, hard_values=hard_v, feasible=feasible, stable=stable,
         starts=tuple(records), best=best.index, seconds=time.perf_counter() - t_start,
-        warnings=tuple(warnings))
+        warnings=tuple(warnings), stages=tuple(stages))
