@@ -151,7 +151,11 @@ class MusynOptions:
         Number of frequencies over the design range of the dense grid on which the
         returned controller's µ is re-computed (the reported ``mu_peak``); the grid also
         extends, 4 points per decade, to three decades below the closed loop's slowest
-        pole and two above its fastest.
+        pole and two above its fastest, and holds 41 points around the design grid's
+        peak and 8 between each of its three highest local maxima and their neighbours
+        (added once the grid's bounds are known).  The default was 400 until
+        2026-12-02: on default ``musyn``'s distillation loop 200 give the same peak
+        (0.959582, a flat µ) at 1.7 s of CPU instead of 2.6 s.
     reduce_order : int, "auto" or None
         If an order, try a balanced truncation of the best controller to this order and
         keep it when its loop is stable, meets the constraints, and its µ peak stays
@@ -294,7 +298,7 @@ class MusynOptions:
     hinfsyn_options: object | None = None
     max_dfit_order: int = 4
     dfit_rtol: float = 0.03
-    n_dense: int = 400
+    n_dense: int = 200
     reduce_order: int | str | None = None
     reduce_mu_tol: float = 0.02
     stop_on_kstep_regression: bool = True
@@ -943,11 +947,58 @@ def _certified(setup, best, history, stop_reason: str, t_start: float,
 
 def _dense_certificate(setup, K, peak_omega: float):
     """``(CL_full, CL, dense, final)``: ``K``'s loop and its µ bounds on the dense grid
-    (:func:`_dense_grid`, :func:`_final_bounds`)."""
+    (:func:`_dense_grid`, :func:`_final_bounds`), its highest local maxima refined
+    (:func:`_refine_peaks`)."""
     CL_full = lft(setup.G, K)
     CL = balanced_statespace(mu_part(CL_full, setup.struct))
     dense = _dense_grid(setup.omega, int(setup.options.n_dense), peak_omega, CL)
-    return CL_full, CL, dense, _final_bounds(CL, setup.struct, dense, setup.rng)
+    final = _final_bounds(CL, setup.struct, dense, setup.rng)
+    return (CL_full, CL, *_refine_peaks(CL, setup.struct, dense, final, setup.rng))
+
+
+#: local maxima of the dense grid's upper bound refined by :func:`_refine_peaks`, and the
+#: points added between each and its two neighbours
+_PEAKS_REFINED = 3
+_PEAK_POINTS = 8
+
+
+def _refine_peaks(CL, struct: BlockStructure, omega: np.ndarray, mu, rng):
+    """``(omega, mu)`` with ``_PEAK_POINTS`` more frequencies between each of the
+    ``_PEAKS_REFINED`` highest local maxima of ``mu.upper`` and its neighbours, their
+    bounds by :func:`_final_bounds`: a peak sharper than the grid is resolved where
+    it shows, at a few dozen points instead of a finer grid everywhere (the grid's
+    fast bound is most of a default run's certificate: 2.6 s of CPU on distillation's
+    531 points, 1.7 s on 333, measured 2026-12-02)."""
+    upper = np.asarray(mu.upper)
+    if upper.size < 3:
+        return omega, mu
+    inner = np.flatnonzero((upper[1:-1] >= upper[:-2]) & (upper[1:-1] >= upper[2:])) + 1
+    ends = [k for k in (0, upper.size - 1)
+            if upper[k] >= upper[1 if k == 0 else upper.size - 2]]
+    peaks = np.concatenate([inner, np.asarray(ends, dtype=int)])
+    peaks = peaks[np.argsort(-upper[peaks], kind="stable")][:_PEAKS_REFINED]
+    extra = []
+    for k in peaks:
+        lo, hi = omega[max(k - 1, 0)], omega[min(k + 1, upper.size - 1)]
+        extra.append(np.logspace(np.log10(lo), np.log10(hi), _PEAK_POINTS + 2)[1:-1])
+    extra = np.setdiff1d(np.concatenate(extra), omega)
+    if not extra.size:
+        return omega, mu
+    more = _final_bounds(CL, struct, extra, rng)
+    grid = np.concatenate([omega, extra])
+    order = np.argsort(grid, kind="stable")
+
+    def merged(a, b):
+        return np.concatenate([np.asarray(a), np.asarray(b)], axis=-1)[..., order]
+
+    fields = {k: merged(getattr(mu, k), getattr(more, k)) for k in
+              ("upper", "lower", "D_left", "D_right", "G", "d_blocks", "delta")}
+    k_peak = int(np.argmax(fields["upper"]))
+    timings = type(mu.timings)(**{k: getattr(mu.timings, k) + getattr(more.timings, k)
+                                  for k in ("upper", "lower", "total")})
+    return grid[order], replace(mu, omega=grid[order], peak=float(fields["upper"][k_peak]),
+                                peak_omega=float(grid[order][k_peak]), timings=timings,
+                                warnings=tuple(mu.warnings) + tuple(more.warnings), **fields)
 
 
 def _against_complex(setup, rival: _ComplexRun, history, best, stop_reason: str):

@@ -94,7 +94,7 @@ _CHECK_RTOL = 1e-2
 #: 6 s), from dkpy's realization 0.959212 at point 127 and 0.958984 at 200 (measured
 #: 2026-12-02, benchmarks/musyn_vs_dkpy.py)
 _STALL_RTOL = 1e-4
-_STALL_STEPS = 3
+_STALL_STEPS = 2
 #: what a point's synthesis may raise (slycot raises plain ValueError/ArithmeticError)
 _FAILED_POINT = (LmiSuspensionError, ValueError, ArithmeticError, np.linalg.LinAlgError)
 

@@ -429,6 +429,11 @@ def _hinfsyn_riccati(G: GeneralizedPlant, opts: HinfsynOptions, t0: float,
                          warnings=tuple(warnings), controller_fastest_pole=_fastest_pole(K))
 
 
+#: widenings of a missed bracket in :func:`_bisect_riccati` (``certify`` False) before the
+#: search from its ends: 4**6 = 4096 times its width
+_RICCATI_WIDEN_STEPS = 6
+
+
 def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warnings: list,
                     bracket: tuple | None = None, certify: bool = True, test=None):
     """γ search over SLICOT's suboptimal controllers (``sb10ad`` job 4), every level judged
@@ -499,11 +504,31 @@ def _bisect_riccati(G: GeneralizedPlant, synthesise, opts: HinfsynOptions, warni
         # within ±3 %.  So the bracket is halved at once and an end tested only where
         # the halving never left it: the same level as testing both ends first (as
         # below; reaching a level being monotone in it) at two syntheses fewer, of 15
-        # to 20.  A missed bracket costs the halvings spent in it, and the old
-        # procedure then starts from its ends (their results remembered in ``seen``).
+        # to 20.  A missed bracket costs the halvings spent in it; it is then widened
+        # beyond the end it missed, 4, 16, 64 ... times its width (a level just
+        # outside a narrow bracket is found at a few syntheses more), and where that
+        # does not bracket the level either, the old procedure starts from its ends
+        # (their results remembered in ``seen``).
         lo, hi, _ = bisect(lo0, hi0)
-        if (lo > lo0 or not achieved(lo0)) and (hi < hi0 or achieved(hi0)):
+        above = hi == hi0 and not achieved(hi0)
+        below = not above and lo == lo0 and achieved(lo0)
+        if not (above or below):
             return None, hi
+        width = hi0 - lo0
+        for _ in range(_RICCATI_WIDEN_STEPS):
+            width *= 4.0
+            if above:
+                lo, hi = hi0, hi0 + width
+                if achieved(hi):
+                    return None, bisect(lo, hi)[1]
+                hi0 = hi
+            else:
+                lo, hi = lo0 - width, lo0
+                if lo <= 0.0:
+                    break
+                if not achieved(lo):
+                    return None, bisect(lo, hi)[1]
+                lo0 = lo
     lo, hi = (0.0, 1.0) if bracket is None else map(float, bracket)
     lo_unachieved = False
     for _ in range(_RICCATI_BRACKET_STEPS):
