@@ -1174,3 +1174,123 @@ def test_auto_order_reduction_keeps_mu_within_its_tolerance():
     assert mu["reduced"] == pytest.approx(res.mu_peak, rel=0.01)
     assert res.mu_peak <= res.mu_peak_full * (1 + tol)
     assert res.mu_bound >= res.mu_peak * (1 - 1e-9)
+
+
+def test_dscale_search_ties_blocks_whose_scalings_differ_at_a_few_frequencies():
+    """Blocks whose optimal scalings agree (to _TIE_RTOL) at all but a fraction
+    _TIE_OUTLIERS of the grid share one fit: the fast bound's scalings of the
+    distillation loop's two input blocks differed by 1.4 % at one of 61 frequencies on
+    dkpy's realization (dsearch._TIE_OUTLIERS).  Reference: the counts themselves --
+    one differing frequency of 61 ties, four (6.6 %) do not."""
+    from lmi_suspension.mu.dsearch import _equal_scalings
+
+    d = np.vstack([np.linspace(1.0, 3.0, 61)] * 3)
+    d[2] = 1.0  # the normalised block
+    one = d.copy()
+    one[1, 29] *= 1.014
+    assert _equal_scalings(one, [0, 1]) == [[0, 1]]
+    four = d.copy()
+    four[1, [3, 20, 29, 50]] *= 1.014
+    assert _equal_scalings(four, [0, 1]) == [[0], [1]]
+    assert _equal_scalings(d, [0, 1, 2]) == [[0, 1], [2]]
+
+
+def test_dscale_search_ends_where_its_level_stalls():
+    """A level that never falls (constant) ends the search after the points of
+    _STALL_STEPS gradients, well before max_evals, at the start (its controller
+    certified as ever).  Reference: the stall window counted here from the number of
+    search parameters (9 of one order-4 fit shared by the two input blocks, plus the
+    trial point of each gradient)."""
+    from lmi_suspension.mu import dsearch
+    from lmi_suspension.synthesis import HinfsynOptions
+
+    ex = skogestad_distillation()
+    w = np.logspace(-3, 3, 31)
+    opts = HinfsynOptions(riccati_search="bisection")
+    K1 = hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati", options=opts).K
+    mu1 = mussv(freqresp(lft(ex.P, K1), w), ex.blk)
+    calls = []
+
+    def level(PD, bracket, rtol):
+        calls.append(1)
+        return 1.5
+
+    def controller(PD, g):
+        return hinfsyn(PD, ex.nmeas, ex.ncon, method="riccati",
+                       options=dataclasses.replace(opts, gamma=None)).K
+
+    found = dsearch.search_dscales(ex.P, ex.nmeas, ex.ncon, [(1, 1), (1, 1), (2, 2)], w,
+                                   mu1.d_blocks, None, 4, level, controller, max_evals=300)
+    window = dsearch._STALL_STEPS * (9 + 1)
+    assert found.evaluations == len(calls) == 1 + window < 300
+    assert found.level == found.level_start == 1.5
+    assert np.isfinite(found.gamma)
+
+
+def test_riccati_level_widens_a_missed_bracket():
+    """riccati_level from a narrow bracket that misses the level, above it or below it,
+    ends at the level bisected from no bracket at all, to the bisection's width.
+    Reference: the bracketless bisection of the same SLICOT test (distillation's
+    optimal γ, 1.1798 in Skogestad & Postlethwaite 2005, Table 8.1)."""
+    from lmi_suspension.synthesis import HinfsynOptions
+    from lmi_suspension.synthesis.hinfsyn import riccati_achieves, riccati_level
+
+    ex = skogestad_distillation()
+    opts = HinfsynOptions(riccati_rtol=1e-7)
+    free = riccati_level(ex.P, ex.nmeas, ex.ncon, opts)
+    assert free == pytest.approx(1.1798, abs=1e-4)
+    assert riccati_achieves(ex.P, ex.nmeas, ex.ncon, free)
+    assert not riccati_achieves(ex.P, ex.nmeas, ex.ncon, free * (1 - 1e-6))
+    for bracket in ((1.15, 1.1501), (1.179, 1.1791), (1.25, 1.2501), (1.1797, 1.17975)):
+        got = riccati_level(ex.P, ex.nmeas, ex.ncon, opts, bracket=bracket)
+        assert got == pytest.approx(free, rel=2e-7), bracket
+
+
+def test_dense_certificate_refines_a_peak_between_grid_points():
+    """_refine_peaks adds points around the highest local maxima of a coarse grid:
+    on a lightly damped loop (ζ = 0.01 at 1 rad/s, one full 1x1 block, where µ is
+    |M(jω)|) whose peak falls between grid points, the refined peak is higher and
+    equals |M| at its frequency, the grid stays sorted and every field follows it.
+    Reference: |M(jω)| evaluated here at the merged grid (numpy), and its supremum
+    1/(2ζ sqrt(1-ζ²)) bounding the refined peak."""
+    from lmi_suspension.mu.dk import _final_bounds, _refine_peaks
+    from lmi_suspension.umodel.blocks import BlockStructure
+
+    zeta = 0.01
+    CL = control.ss(control.tf([1.0], [1.0, 2 * zeta, 1.0]))
+    struct = BlockStructure.coerce([[1, 1]])
+    w = np.logspace(-1, 1, 12)  # 1 rad/s falls between two points
+    rng = np.random.default_rng(0)
+    coarse = _final_bounds(CL, struct, w, rng)
+    grid, mu = _refine_peaks(CL, struct, w, coarse, rng)
+    assert np.all(np.diff(grid) > 0) and set(w) <= set(grid) and grid.size > w.size
+    exact = np.abs(1.0 / (1.0 - grid**2 + 2j * zeta * grid))
+    np.testing.assert_allclose(mu.upper, exact, rtol=1e-6)
+    assert np.asarray(mu.D_left).shape[-1] == grid.size == np.asarray(mu.lower).size
+    assert mu.peak == pytest.approx(float(np.max(exact)), rel=1e-9)
+    assert coarse.peak * 2 < mu.peak <= 1 / (2 * zeta * np.sqrt(1 - zeta**2)) * (1 + 1e-9)
+    assert mu.peak_omega == grid[int(np.argmax(mu.upper))]
+
+
+def test_level_led_kstep_keeps_slicots_controller_on_a_large_scaled_plant():
+    """On a scaled plant of more than _LEVEL_LED_MAX_STATES states the LMI K-step at a
+    fixed level returns SLICOT's controller, certified, without an LMI (36-38 state
+    D-G-K plants took 13-72 s per LMI).  The plant: distillation with 26 extra stable
+    states that neither the inputs nor the outputs see (32 states, the same closed-loop
+    norm); reference: hinfnorm of the returned controller's loop, computed here."""
+    from lmi_suspension.mu.steps.kstep import _LEVEL_LED_MAX_STATES, _k_step
+
+    ex = skogestad_distillation()
+    G = ex.P
+    n_extra = 26
+    A = np.block([[np.asarray(G.A), np.zeros((G.nstates, n_extra))],
+                  [np.zeros((n_extra, G.nstates)), -np.diag(np.linspace(1.0, 5.0, n_extra))]])
+    B = np.vstack([np.asarray(G.B), np.zeros((n_extra, G.ninputs))])
+    C = np.hstack([np.asarray(G.C), np.zeros((G.noutputs, n_extra))])
+    big = control.ss(A, B, C, np.asarray(G.D))
+    assert big.nstates > _LEVEL_LED_MAX_STATES
+    syn = _k_step(_hinfsyn, big, ex.nmeas, ex.ncon, MusynOptions(), gamma_prev=1.25)
+    assert any("no LMI K-step" in w for w in syn.warnings)
+    assert syn.gamma == pytest.approx(float(hinfnorm(lft(big, syn.K, ex.nmeas, ex.ncon))[0]),
+                                      rel=1e-6)
+    assert syn.gamma == pytest.approx(1.1798, rel=2e-3)  # the book's optimum (Table 8.1)
