@@ -44,7 +44,8 @@ if __name__ == "__main__":
     cpu = sum(getattr(c1, k) - getattr(c0, k) for k in
               ("user", "system", "children_user", "children_system"))
     print(f"{problem} {kw}: µ {res.mu_peak:.4f} (lower {res.mu_lower_peak:.4f}), "
-          f"K order {res.K.nstates}, {seconds:.1f} s (CPU {cpu:.1f} s), best iteration {res.best_iteration}, "
+          f"K order {res.K.nstates}, {seconds:.1f} s (CPU {cpu:.1f} s), best iteration "
+          f"{res.best_iteration}, "
           f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB")
     print("stop:", res.stop_reason)
     if res.complex_run is not None:

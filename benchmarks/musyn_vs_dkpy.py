@@ -100,7 +100,8 @@ if __name__ == "__main__":
     if dkpy is not None:
         eg = dkpy.example_skogestad2006_p325()
         P, nmeas, ncon = eg["P"], eg["n_y"], eg["n_u"]
-        print(f"dkpy {importlib.metadata.version('dkpy')}: its examples/1 (DkIterFixedOrder, SLICOT K-step, "
+        print(f"dkpy {importlib.metadata.version('dkpy')}: its examples/1 "
+              "(DkIterFixedOrder, SLICOT K-step, "
               "3 iterations, fit order 4)")
     else:
         ex = skogestad_distillation()

@@ -1121,7 +1121,8 @@ def test_default_lmi_dk_on_distillation_goes_below_one():
 
 def test_final_bounds_peak_is_the_lmi_bound_peak(monkeypatch):
     """_final_bounds refines the fast upper bound with the D-G bound (AB13MD's on this
-    structure of square full blocks) where it sets the peak.  A stalled fast bound is injected (mussv's fast result inflated by 1 %, as
+    structure of square full blocks) where it sets the peak.  A stalled fast bound is
+    injected (mussv's fast result inflated by 1 %, as
     BFGS stalls on flat optimised loops); the reference is mussv's LMI upper bound at
     every frequency of the same loop (the plain H∞ controller on distillation, 41
     points): the refined peak equals its largest value, and no bound exceeds the
