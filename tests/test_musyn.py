@@ -1272,26 +1272,3 @@ def test_dense_certificate_refines_a_peak_between_grid_points():
     assert coarse.peak * 2 < mu.peak <= 1 / (2 * zeta * np.sqrt(1 - zeta**2)) * (1 + 1e-9)
     assert mu.peak_omega == grid[int(np.argmax(mu.upper))]
 
-
-def test_level_led_kstep_keeps_slicots_controller_on_a_large_scaled_plant():
-    """On a scaled plant of more than _LEVEL_LED_MAX_STATES states the LMI K-step at a
-    fixed level returns SLICOT's controller, certified, without an LMI (36-38 state
-    D-G-K plants took 13-72 s per LMI).  The plant: distillation with 26 extra stable
-    states that neither the inputs nor the outputs see (32 states, the same closed-loop
-    norm); reference: hinfnorm of the returned controller's loop, computed here."""
-    from lmi_suspension.mu.steps.kstep import _LEVEL_LED_MAX_STATES, _k_step
-
-    ex = skogestad_distillation()
-    G = ex.P
-    n_extra = 26
-    A = np.block([[np.asarray(G.A), np.zeros((G.nstates, n_extra))],
-                  [np.zeros((n_extra, G.nstates)), -np.diag(np.linspace(1.0, 5.0, n_extra))]])
-    B = np.vstack([np.asarray(G.B), np.zeros((n_extra, G.ninputs))])
-    C = np.hstack([np.asarray(G.C), np.zeros((G.noutputs, n_extra))])
-    big = control.ss(A, B, C, np.asarray(G.D))
-    assert big.nstates > _LEVEL_LED_MAX_STATES
-    syn = _k_step(_hinfsyn, big, ex.nmeas, ex.ncon, MusynOptions(), gamma_prev=1.25)
-    assert any("no LMI K-step" in w for w in syn.warnings)
-    assert syn.gamma == pytest.approx(float(hinfnorm(lft(big, syn.K, ex.nmeas, ex.ncon))[0]),
-                                      rel=1e-6)
-    assert syn.gamma == pytest.approx(1.1798, rel=2e-3)  # the book's optimum (Table 8.1)

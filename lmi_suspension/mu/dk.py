@@ -118,10 +118,8 @@ class MusynOptions:
         posed at a level fixed in advance, 0.3 % above the norm certified for SLICOT's
         controller on the scaled plant (a feasibility problem only, then, under the
         default ``hinfsyn_options``, the explicit controller formulas, with the
-        controller LMI where they fail their certificate or pole cap); on scaled plants
-        of more than 30 states SLICOT's certified controller is the K-step's (no LMI:
-        13-72 s each on D-G-K's 36-38 state plants of the two-mass problem, measured
-        2026-12-02).  Where the LMI finds none there, the K-step fails.  Where SLICOT
+        controller LMI where they fail their certificate or pole cap).  Where the LMI
+        finds none there, the K-step fails.  Where SLICOT
         finds none at all, it minimises γ, knowing the previous controller's level on
         the new scaled plant: the minimisation starts in the frame of the Riccati
         solutions at that level and gives up where it stops above it (``gamma_abort``,

@@ -51,13 +51,6 @@ _CENTRAL_START_RELAX = 0.01
 #: the level of the LMI K-step above the γ certified for SLICOT's controller
 #: (:func:`_level_led_lmi`)
 _LEVEL_RELAX = 3e-3
-#: largest scaled plant on which the K-step at a fixed level runs the LMI after SLICOT's
-#: controller; above it SLICOT's certified controller is the K-step's.  D-G-K on the
-#: two-mass plant (:func:`~lmi_suspension.examples.uncertain_two_mass`) builds 36-38
-#: state scaled plants, whose LMI K-steps took 47-72 s each (load 7 on 2 cores; 13-16 s
-#: on a quiet machine), most of the run (measured 2026-12-02); the same bound as
-#: ``_LMI_FALLBACK_MAX_STATES``
-_LEVEL_LED_MAX_STATES = _LMI_FALLBACK_MAX_STATES
 #: Clarabel recoveries and reconstruction levels of that K-step's controller LMI: it
 #: succeeded at its second attempt on 5 of 7 plants of a distillation run, and on the
 #: other two further recoveries cost 9 s each and ended "infeasible" all the same.  Its
@@ -380,10 +373,6 @@ def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base, controller: str = "
         return None
     if not np.isfinite(ric.gamma):
         return None
-    if PD.nstates > _LEVEL_LED_MAX_STATES:
-        return replace(ric, warnings=tuple(ric.warnings) + (
-            f"SLICOT's controller, certified {ric.gamma:.6g}: no LMI K-step on a "
-            f"{PD.nstates}-state scaled plant",))
     level = float(ric.gamma) * (1.0 + _LEVEL_RELAX)
     try:
         res = hinfsyn(PD, nmeas, ncon, method="lmi",
