@@ -223,9 +223,9 @@ class MusynOptions:
         for constant scalings (``max_dfit_order = 0``), with constraints, with real
         blocks kept real (D-G-K), and once ``mu_target`` is met; it stops as soon as an
         accepted level is below ``mu_target``, and where its best level has not fallen
-        by 0.01 % over the points of two gradients (:mod:`.dsearch`; on distillation
-        from dkpy's realization: 147 points, level 0.959188, where the 200 points of
-        the bound reached 0.958984, 53 points more; measured 2026-12-02).  A level
+        by 0.01 % over the points of three gradients (:mod:`.dsearch`; on distillation
+        from dkpy's realization: 157 points, level 0.959188, where the 200 points of
+        the bound reached 0.958984; measured 2026-12-02).  A level
         costs 15 (difference quotient) to 20 (trial step) syntheses of 3-4 ms on
         distillation's 22-state scaled plants, a trial point found above the current
         level one (measured 2026-11-28).  Repeated-scalar blocks are searched with
