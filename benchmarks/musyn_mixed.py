@@ -13,6 +13,7 @@ second K-step (2026-12-02).
 
 import ast
 import logging
+import os
 import resource
 import sys
 import time
@@ -31,7 +32,7 @@ if __name__ == "__main__":
     problem = sys.argv[1] if len(sys.argv) > 1 else "two_mass"
     kw = {k.strip(): ast.literal_eval(v) for k, v in
           (item.split("=", 1) for item in sys.argv[2:])}
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), os.times()
     if problem == "oscillator":
         ex = stiffness_oscillator()
         res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-2, 1.5, 40),
@@ -39,12 +40,16 @@ if __name__ == "__main__":
     else:
         res = musyn(uncertain_two_mass(), 1, 1, options=MusynOptions(**kw))
     seconds = time.perf_counter() - t0
+    c1 = os.times()  # CPU of this process and its finished children (AB13MD's)
+    cpu = sum(getattr(c1, k) - getattr(c0, k) for k in
+              ("user", "system", "children_user", "children_system"))
     print(f"{problem} {kw}: µ {res.mu_peak:.4f} (lower {res.mu_lower_peak:.4f}), "
-          f"K order {res.K.nstates}, {seconds:.1f} s, best iteration {res.best_iteration}, "
+          f"K order {res.K.nstates}, {seconds:.1f} s (CPU {cpu:.1f} s), best iteration "
+          f"{res.best_iteration}, "
           f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB")
     print("stop:", res.stop_reason)
     if res.complex_run is not None:
-        print(f"complexified run: {res.complex_run.seconds:.1f} s, complex µ per iterate "
+        print(f"complexified run: {res.complex_run.seconds:.1f} s (wall), complex µ per iterate "
               f"{[round(h.mu_peak, 4) for h in res.complex_run.history]}, its mixed µ "
               f"{res.complex_run.mu_peak}")
     for h in res.history:

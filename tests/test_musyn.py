@@ -644,13 +644,18 @@ def test_riccati_level_from_a_bracket_that_holds_or_misses(monkeypatch):
     opts = HinfsynOptions(riccati_rtol=rtol)
     g0 = riccati_level(ex.P, ex.nmeas, ex.ncon, opts)
     calls = []
-    sb10ad = module._sb10ad
+    tester = module._sb10ad_stabilises  # the test bisected: one sb10ad call each
 
-    def counted(G, gamma):
-        calls.append(gamma)
-        return sb10ad(G, gamma)
+    def counted(G):
+        test = tester(G)
 
-    monkeypatch.setattr(module, "_sb10ad", counted)
+        def counted_test(gamma):
+            calls.append(gamma)
+            return test(gamma)
+
+        return counted_test
+
+    monkeypatch.setattr(module, "_sb10ad_stabilises", counted)
     holds = (g0 * (1 - 1e-3), g0 * (1 + 1e-3))
     for bracket in (holds, (0.0, g0 * 2), (g0 * 1.01, g0 * 1.02), (g0 * 0.98, g0 * 0.99),
                     (g0 * (1 - 1e-3), g0 * (1 + 1e-9)), (g0 * (1 - 1e-9), g0 * (1 + 1e-3))):
@@ -1120,8 +1125,9 @@ def test_default_lmi_dk_on_distillation_goes_below_one():
 
 
 def test_final_bounds_peak_is_the_lmi_bound_peak(monkeypatch):
-    """_final_bounds refines the fast upper bound with the LMI bound where it sets the
-    peak.  A stalled fast bound is injected (mussv's fast result inflated by 1 %, as
+    """_final_bounds refines the fast upper bound with the D-G bound (AB13MD's on this
+    structure of square full blocks) where it sets the peak.  A stalled fast bound is
+    injected (mussv's fast result inflated by 1 %, as
     BFGS stalls on flat optimised loops); the reference is mussv's LMI upper bound at
     every frequency of the same loop (the plain H∞ controller on distillation, 41
     points): the refined peak equals its largest value, and no bound exceeds the
@@ -1137,7 +1143,7 @@ def test_final_bounds_peak_is_the_lmi_bound_peak(monkeypatch):
 
     def stalled(M, blk, *, method="auto", **kw):
         res = real(M, blk, method=method, **kw)
-        if method == "lmi":
+        if method in ("lmi", "ab13md"):  # the refinement's bounds (AB13MD's here)
             return res
         upper = 1.01 * np.asarray(res.upper)
         return dataclasses.replace(res, upper=upper, peak=float(np.max(upper)))
@@ -1174,3 +1180,100 @@ def test_auto_order_reduction_keeps_mu_within_its_tolerance():
     assert mu["reduced"] == pytest.approx(res.mu_peak, rel=0.01)
     assert res.mu_peak <= res.mu_peak_full * (1 + tol)
     assert res.mu_bound >= res.mu_peak * (1 - 1e-9)
+
+
+def test_dscale_search_ties_blocks_whose_scalings_differ_at_a_few_frequencies():
+    """Blocks whose optimal scalings agree (to _TIE_RTOL) at all but a fraction
+    _TIE_OUTLIERS of the grid share one fit: the fast bound's scalings of the
+    distillation loop's two input blocks differed by 1.4 % at one of 61 frequencies on
+    dkpy's realization (dsearch._TIE_OUTLIERS).  Reference: the counts themselves --
+    one differing frequency of 61 ties, four (6.6 %) do not."""
+    from lmi_suspension.mu.dsearch import _equal_scalings
+
+    d = np.vstack([np.linspace(1.0, 3.0, 61)] * 3)
+    d[2] = 1.0  # the normalised block
+    one = d.copy()
+    one[1, 29] *= 1.014
+    assert _equal_scalings(one, [0, 1]) == [[0, 1]]
+    four = d.copy()
+    four[1, [3, 20, 29, 50]] *= 1.014
+    assert _equal_scalings(four, [0, 1]) == [[0], [1]]
+    assert _equal_scalings(d, [0, 1, 2]) == [[0, 1], [2]]
+
+
+def test_dscale_search_ends_where_its_level_stalls():
+    """A level that never falls (constant) ends the search after the points of
+    _STALL_STEPS gradients, well before max_evals, at the start (its controller
+    certified as ever).  Reference: the stall window counted here from the number of
+    search parameters (9 of one order-4 fit shared by the two input blocks, plus the
+    trial point of each gradient)."""
+    from lmi_suspension.mu import dsearch
+    from lmi_suspension.synthesis import HinfsynOptions
+
+    ex = skogestad_distillation()
+    w = np.logspace(-3, 3, 31)
+    opts = HinfsynOptions(riccati_search="bisection")
+    K1 = hinfsyn(ex.P, ex.nmeas, ex.ncon, method="riccati", options=opts).K
+    mu1 = mussv(freqresp(lft(ex.P, K1), w), ex.blk)
+    calls = []
+
+    def level(PD, bracket, rtol):
+        calls.append(1)
+        return 1.5
+
+    def controller(PD, g):
+        return hinfsyn(PD, ex.nmeas, ex.ncon, method="riccati",
+                       options=dataclasses.replace(opts, gamma=None)).K
+
+    found = dsearch.search_dscales(ex.P, ex.nmeas, ex.ncon, [(1, 1), (1, 1), (2, 2)], w,
+                                   mu1.d_blocks, None, 4, level, controller, max_evals=300)
+    window = dsearch._STALL_STEPS * (9 + 1)
+    assert found.evaluations == len(calls) == 1 + window < 300
+    assert found.level == found.level_start == 1.5
+    assert np.isfinite(found.gamma)
+
+
+def test_riccati_level_widens_a_missed_bracket():
+    """riccati_level from a narrow bracket that misses the level, above it or below it,
+    ends at the level bisected from no bracket at all, to the bisection's width.
+    Reference: the bracketless bisection of the same SLICOT test (distillation's
+    optimal γ, 1.1798 in Skogestad & Postlethwaite 2005, Table 8.1)."""
+    from lmi_suspension.synthesis import HinfsynOptions
+    from lmi_suspension.synthesis.hinfsyn import riccati_achieves, riccati_level
+
+    ex = skogestad_distillation()
+    opts = HinfsynOptions(riccati_rtol=1e-7)
+    free = riccati_level(ex.P, ex.nmeas, ex.ncon, opts)
+    assert free == pytest.approx(1.1798, abs=1e-4)
+    assert riccati_achieves(ex.P, ex.nmeas, ex.ncon, free)
+    assert not riccati_achieves(ex.P, ex.nmeas, ex.ncon, free * (1 - 1e-6))
+    for bracket in ((1.15, 1.1501), (1.179, 1.1791), (1.25, 1.2501), (1.1797, 1.17975)):
+        got = riccati_level(ex.P, ex.nmeas, ex.ncon, opts, bracket=bracket)
+        assert got == pytest.approx(free, rel=2e-7), bracket
+
+
+def test_dense_certificate_refines_a_peak_between_grid_points():
+    """_refine_peaks adds points around the highest local maxima of a coarse grid:
+    on a lightly damped loop (ζ = 0.01 at 1 rad/s, one full 1x1 block, where µ is
+    |M(jω)|) whose peak falls between grid points, the refined peak is higher and
+    equals |M| at its frequency, the grid stays sorted and every field follows it.
+    Reference: |M(jω)| evaluated here at the merged grid (numpy), and its supremum
+    1/(2ζ sqrt(1-ζ²)) bounding the refined peak."""
+    from lmi_suspension.mu.dk import _final_bounds, _refine_peaks
+    from lmi_suspension.umodel.blocks import BlockStructure
+
+    zeta = 0.01
+    CL = control.ss(control.tf([1.0], [1.0, 2 * zeta, 1.0]))
+    struct = BlockStructure.coerce([[1, 1]])
+    w = np.logspace(-1, 1, 12)  # 1 rad/s falls between two points
+    rng = np.random.default_rng(0)
+    coarse = _final_bounds(CL, struct, w, rng)
+    grid, mu = _refine_peaks(CL, struct, w, coarse, rng)
+    assert np.all(np.diff(grid) > 0) and set(w) <= set(grid) and grid.size > w.size
+    exact = np.abs(1.0 / (1.0 - grid**2 + 2j * zeta * grid))
+    np.testing.assert_allclose(mu.upper, exact, rtol=1e-6)
+    assert np.asarray(mu.D_left).shape[-1] == grid.size == np.asarray(mu.lower).size
+    assert mu.peak == pytest.approx(float(np.max(exact)), rel=1e-9)
+    assert coarse.peak * 2 < mu.peak <= 1 / (2 * zeta * np.sqrt(1 - zeta**2)) * (1 + 1e-9)
+    assert mu.peak_omega == grid[int(np.argmax(mu.upper))]
+
