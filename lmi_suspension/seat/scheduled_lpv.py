@@ -50,9 +50,9 @@ import control
 import numpy as np
 from scipy import optimize
 
-from ..errors import ParameterError
+from ..errors import ParameterError, SolverError
 from ..lti import freqresp, lft
-from ..synthesis.lpv import BACKOFF, LpvsynResult, ScheduledController, lpvsyn
+from ..synthesis.lpv import LpvsynResult, ScheduledController, lpvsyn
 from .augmented import SeatAugmentedPlant, SeatDesignOptions, seat_augmented_plant
 from .design import DEFAULT_DESIGN
 from .params import SeatParameters
@@ -60,6 +60,7 @@ from .params import SeatParameters
 __all__ = [
     "SCHEDULED_DESIGN",
     "SCHEDULED_GRID",
+    "SEAT_BACKOFF",
     "SHIPPED_SCHEDULED",
     "LpvDkIteration",
     "ScheduledRsMu",
@@ -78,14 +79,28 @@ logger = logging.getLogger(__name__)
 _ELEMENTS = ("k1", "k2", "k3", "c1", "c2", "c3")
 
 #: The µ route's weights (:data:`~.design.DEFAULT_DESIGN`) with the six unmeasured
-#: elements (±20 %) as complex uncertainty channels and the occupant mass fixed (it is
-#: the scheduling variable, not an uncertainty).
+#: elements as complex uncertainty channels and the occupant mass fixed (it is the
+#: scheduling variable, not an uncertainty).  The channels cover ±10 % of each element,
+#: half the set's ±20 %: a trade-off knob.  Measured 2026-12-02 (5 masses, 2 D-K
+#: iterations, back-off 0.1; ``benchmarks/scheduled_seat.py --quick --no-mu``, 8 seats):
+#: nominal / worst peak ratio and unstable loops of 48 for the cover 0 (delay cover
+#: only, 7 masses) 1.59 / inf, 4; ±5 % 2.07 / inf, 6; ±10 % 2.25 / 3.03, 0; ±20 %
+#: 2.68 / 3.42, 0 -- the complex cover of real elements costs comfort fast, and less
+#: cover leaves seats of the set unstable.
 SCHEDULED_DESIGN = replace(DEFAULT_DESIGN, include_parametric=True, parametric_complex=True,
-                           m3_range=None, stiffness=_ELEMENTS[:3], stiffness_rel=0.2,
-                           damping=_ELEMENTS[3:], damping_rel=0.2)
+                           m3_range=None, stiffness=_ELEMENTS[:3], stiffness_rel=0.1,
+                           damping=_ELEMENTS[3:], damping_rel=0.1)
 
-#: The design grid of the occupant mass, kg.
-SCHEDULED_GRID = np.linspace(30.0, 70.0, 5)
+#: lpvsyn's reconstruction back-off for the seat: at its default 0.02 the delay-cover
+#: design's controllers had poles at 2.7e3-6.7e3 rad/s, at 0.1 1.9e3 (measured
+#: 2026-12-02); a 1 kHz loop resolves only up to 3.1e3.
+SEAT_BACKOFF = 0.1
+
+#: The design grid of the occupant mass, kg: uniform in ``1/m3`` (the force acts through
+#: it), so denser at the light end.  With 5 masses uniform in ``m3`` the LMIs between
+#: 30 and 40 kg failed up to 4 times the level at 32.5, 35 and 37.5 kg (no controller
+#: there; delay-cover design, measured 2026-12-02); uniform in ``1/m3`` they hold.
+SCHEDULED_GRID = np.sort(1.0 / np.linspace(1.0 / 70.0, 1.0 / 30.0, 5))
 
 #: The D-step's frequency grid, rad/s (that of the µ route's design, denser).
 _D_OMEGA = np.logspace(-1.0, 3.5, 80)
@@ -103,6 +118,15 @@ _LOGD_BOUND = 12.0
 #: variables: 400 per variable moved the peak by < 1e-6 beyond 200, measured on the
 #: first iterate of the default design, 2026-12-02).
 _D_EVALS = 200
+
+
+#: Back-offs tried in turn, after the D-K iteration, until every controller on the
+#: certificate's grid has its poles inside ``pole_radius``: lpvsyn's poles grow like
+#: 1/backoff near the optimum (its ``BACKOFF`` docstring); at 0.1 the delay-cover design
+#: on 7 masses had its fastest pole at 1905 rad/s (70 kg), the element-channel design on
+#: 5 masses at 5537 rad/s (measured 2026-12-02).  Re-forming costs no SDP: the same
+#: X(p), Y(p) at a higher level, certified anew.
+_BACKOFFS = (0.1, 0.15, 0.2, 0.3, 0.5, 1.0, 2.0)
 
 
 def _basis(m3):
@@ -227,6 +251,54 @@ def _dstep(Ms, sizes, start) -> tuple[np.ndarray, float]:
     return (x, f) if f < f0 else (start, f0)
 
 
+def _fastest(K, masses) -> float:
+    return max(float(np.max(np.abs(np.linalg.eigvals(np.asarray(K.at(m3=m).A)))))
+               for m in masses)
+
+
+def _within_radius(res: LpvsynResult, radius: float, backoff: float) -> LpvsynResult:
+    """``res`` with its controllers formed at the first back-off that keeps every pole on
+    the check grid inside ``radius``, certified anew by ``hinfnorm`` at every check
+    point (and lpvsyn's inequality check re-evaluated at the new levels)."""
+    from ..lti import hinfnorm
+
+    masses = [float(m) for m in res.check_grid["m3"]]
+    K = res.K
+    for b in [b for b in _BACKOFFS if b >= backoff] or [backoff]:
+        K = replace(res.K, backoff=b)
+        try:
+            fast = _fastest(K, masses)
+        except (SolverError, np.linalg.LinAlgError) as exc:  # no controller at a point
+            logger.info("back-off %g: %s", b, exc)
+            continue
+        if fast <= radius:
+            break
+    else:
+        fast = math.inf
+    warnings = list(res.warnings)
+    if not fast <= radius:
+        said = f"no back-off up to {K.backoff:g} keeps the poles within {radius:g} rad/s"
+        logger.warning(said)
+        warnings.append(said)
+    if K.backoff == res.K.backoff:
+        return res if len(warnings) == len(res.warnings) else \
+            replace(res, warnings=tuple(warnings))
+    norms, levels, ineq = [], [], []
+    for m in masses:
+        Km, level, _ = K.build(m)
+        gam = float(hinfnorm(lft(K.plant(m), Km))[0])
+        norms.append(gam)
+        levels.append(level)
+        ineq.append(K.inequalities(m, level=level))
+        if not np.isfinite(gam):
+            warnings.append(f"at m3={m:g}: the frozen closed loop is NOT stable")
+    notes = res.notes + ((f"controllers formed at back-off {K.backoff:g} (fastest pole "
+                          f"{fast:.5g} rad/s), certified anew"),)
+    return replace(res, K=K, gamma=float(np.max(norms)), gamma_check=np.asarray(norms),
+                   levels=np.asarray(levels), inequality_check=np.asarray(ineq),
+                   warnings=tuple(warnings), notes=notes)
+
+
 def _dsteps(Ms, sizes, logd, dscales) -> tuple[np.ndarray, np.ndarray]:
     """The D-step at every design mass (``"grid"``) or one for all (``"common"``):
     the new ``log d`` (one row per mass) and the peak at each mass with them."""
@@ -324,9 +396,10 @@ def named_controller(K, m3: float) -> control.StateSpace:
 
 def design_lpv_seat_controller(design: SeatDesignOptions | None = None, *,
                                grid=None, params: SeatParameters | None = None,
-                               dscales: str = "grid", iterations: int = 4,
-                               backoff: float = BACKOFF, omega=None, basis=None,
-                               rtol: float = 0.005, start="shipped") -> ScheduledSeatDesign:
+                               dscales: str = "grid", iterations: int = 2,
+                               backoff: float = SEAT_BACKOFF, omega=None, basis=None,
+                               rtol: float = 0.005, start="shipped",
+                               pole_radius: float | None = None) -> ScheduledSeatDesign:
     """A seat controller scheduled on the occupant mass, by D-K iteration around
     :func:`~lmi_suspension.synthesis.lpv.lpvsyn` (see the module docstring).
 
@@ -341,9 +414,9 @@ def design_lpv_seat_controller(design: SeatDesignOptions | None = None, *,
     dscales : {"grid", "common"}
         Constant D-scales per design mass (interpolated in between) or one set for all.
     iterations : int
-        K-steps at most (the first with unit scalings: the µ weights alone).
+        K-steps at most (each about 4-5 minutes on the default problem).
     backoff : float
-        lpvsyn's reconstruction back-off.
+        lpvsyn's reconstruction back-off (:data:`SEAT_BACKOFF`).
     omega : array_like, optional
         The D-step's frequency grid, rad/s.
     basis : callable, optional
@@ -357,6 +430,14 @@ def design_lpv_seat_controller(design: SeatDesignOptions | None = None, *,
         first LPV step is then badly scaled, the element channels carrying
         ``0.2 k`` N per metre, and Clarabel struggled: γ_lmi 716 against frozen norms
         13-18 and 217 s on the default grid, measured 2026-12-02).
+
+    pole_radius : float or None
+        Largest controller pole magnitude allowed on the certificate's grid, rad/s (a
+        1 kHz loop: 1900, ``seat/sampled.py``): the kept iterate's controllers are formed
+        at the first back-off of :data:`_BACKOFFS` at least ``backoff`` that keeps every
+        pole inside, and certified anew (None, the default: as lpvsyn formed them).  On
+        the default design it does not help: the fastest pole, at 70 kg, is 2.4e4 rad/s
+        at back-off 0.1 and still 8.3e3 at 2.0 (measured 2026-12-02).
 
     Returns
     -------
@@ -415,6 +496,8 @@ def design_lpv_seat_controller(design: SeatDesignOptions | None = None, *,
             break
         logd = new
     res, logd = best
+    if pole_radius is not None:
+        res = _within_radius(res, float(pole_radius), backoff)
     return ScheduledSeatDesign(K=res.K, lpv=res, logd=logd, block_names=names, grid=grid,
                                history=tuple(history), dscales=dscales, design=design,
                                seconds=time.perf_counter() - t0, stop_reason=stop)
