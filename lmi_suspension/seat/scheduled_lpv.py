@@ -13,29 +13,39 @@ step:
   unmeasured elements as uncertainty channels (the elements as complex ``[1, 1]`` blocks,
   a cover of the real ones: constant D-scales cannot use that they are real);
 * **the K-step** is :func:`~lmi_suspension.synthesis.lpv.lpvsyn` (frozen parameter,
-  ``ν = 0``; basis ``[1, m3, 1/m3]``) on that plant with each uncertainty channel
-  scaled by a constant ``d_i(m3)``: since the force enters through ``1/m`` terms, the
-  plant is not affine in ``m3`` with constant ``B2`` and the polytopic route does not
-  apply (``hinfgs`` raises), while the gridded one allows ``B2``, ``C2`` to vary;
+  ``ν = 0``; basis ``[1, m3, 1/m3]``; 5 masses uniform in ``1/m3``) on that plant with
+  each uncertainty channel scaled by a constant ``d_i(m3)``, in state coordinates fixed
+  over the range (the balanced realization at the middle mass).  The force enters
+  through ``1/m`` terms and the plant is not affine in ``m3``: the polytopic route
+  (``hinfgs``, which needs ``B2`` constant) does not apply, the gridded one lets ``B2``,
+  ``C2`` vary;
 * **the D-step** at each design mass: the constant scalings minimising
   ``max_ω σ̄(D M(jω) D⁻¹)`` of that mass's loop (a convex function of ``log d``,
   Sezginer & Overton 1990), minimised directly; between design masses ``log d`` is
-  interpolated linearly.
+  interpolated linearly.  The first scalings come from the D-step of the single-seat
+  design's loops (``seat/data/mu_refined.json``).
 
-Why scalings per design mass (``dscales="grid"``) and not one common set
+Why scalings per design mass (``dscales="grid"``, the default) and not one common set
 (``dscales="common"``, also built): with the mass frozen, any scaling that commutes
 with the uncertainty *at that mass* keeps ``‖D(m3) F_l(P(m3), K(m3)) D(m3)⁻¹‖∞`` an upper
 bound of that frozen loop's robust-performance µ, so ``D`` may depend on ``m3`` as
-freely as the controller does; one common ``D`` is a special case and can only be
-worse at the optimum (the measurement is in the module's test and the benchmark
-``benchmarks/scheduled_seat.py``).  Both are one more LPV step per iteration; the
-common one solves one larger D-step.
+freely as the controller does, and one common ``D`` is a special case of it.  The
+optimal scalings do move with the mass (the element channels' ``log d`` by up to 0.65
+between 30 and 70 kg on the shipped design); on the reduced problem of the tests (delay
+cover of order 1, 3 masses, 3 iterations) per-mass scalings certify 1.4708 against
+1.4777 for a common set, at the same cost (22 s each; measured 2026-12-02).
 
 What is certified, by computations that did not produce the controller: lpvsyn's own
 certificate (every frozen scaled loop on a grid 4 times denser than the design grid,
 by ``hinfnorm``: ``gamma_check`` is, at each mass, an upper bound of the complex-cover
 robust-performance µ), and :func:`robust_stability_mu`, the mixed µ (the elements real)
 of robust stability at a mass, upper bound over every frequency.
+
+What it reaches (``benchmarks/scheduled_seat.py``, 2026-12-02): not the issue's targets.
+The complex cover of six real elements is expensive in comfort and less cover leaves
+seats of the set unstable (the trade-off is at :data:`SCHEDULED_DESIGN`), and the
+controllers' fastest pole (2.4e4 rad/s at 70 kg) is far above what a 1 kHz loop
+resolves; see the benchmark's table.
 """
 
 from __future__ import annotations
