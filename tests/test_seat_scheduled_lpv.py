@@ -137,7 +137,7 @@ def test_a_larger_backoff_slows_the_poles_and_is_certified_anew(small):
     assert np.all(res.inequality_check < 0)
 
 
-@pytest.mark.slow  # 600-900 s on Zen 1 (2026-12-02): the second tier
+@pytest.mark.slow  # 505 s on Zen 1 (2026-12-02, machine shared): the second tier
 def test_the_real_design_is_the_shipped_one_and_round_trips_exactly(tmp_path):
     d = design_lpv_seat_controller()
     from lmi_suspension.seat.scheduled_lpv import save_scheduled_seat
