@@ -37,7 +37,7 @@ import numpy as np
 
 from lmi_suspension.io import load_controller
 from lmi_suspension.seat.occupants import OccupantSet, occupant_samples
-from lmi_suspension.seat.refine import REFINE_DELAYS, BumpResponse
+from lmi_suspension.seat.loop import REFINE_DELAYS, BumpResponse
 from lmi_suspension.seat.sampled import fastest_pole
 from lmi_suspension.seat.scheduled_lpv import (
     SCHEDULED_GRID,

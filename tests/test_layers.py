@@ -150,7 +150,7 @@ def test_no_import_runs_up_a_floor(graph):
 SEAT_FLOORS = (
     ("params", "model", "roads", "comfort", "weights", "simulate", "limit", "uncertainty",
      "augmented", "sampled"),
-    ("loop", "goals", "mucheck", "occupants", "worstcase"),
+    ("loop", "goals", "mucheck", "occupants", "worstcase", "scheduled_lpv"),
     ("record",),
     ("design", "constrained", "bounded", "discrete_design", "refine", "multimodel"),
     ("routes",),

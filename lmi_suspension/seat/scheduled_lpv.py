@@ -9,7 +9,7 @@ step:
 
 * **the plant at each mass** is the µ route's augmented plant
   (:func:`~.augmented.seat_augmented_plant` with the µ weights of
-  :data:`~.design.DEFAULT_DESIGN`) at that ``m3``, with the delay cover and the six
+  :data:`~.augmented.DEFAULT_DESIGN`) at that ``m3``, with the delay cover and the six
   unmeasured elements as uncertainty channels (the elements as complex ``[1, 1]`` blocks,
   a cover of the real ones: constant D-scales cannot use that they are real);
 * **the K-step** is :func:`~lmi_suspension.synthesis.lpv.lpvsyn` (frozen parameter,
@@ -51,6 +51,11 @@ against the single-seat design's 1.43 / 1.99 and the exported robust controller'
 comfort, less cover leaves seats of the set unstable (the trade-off is at
 :data:`SCHEDULED_DESIGN`), and the fastest pole is far above what a 1 kHz loop
 resolves.
+
+The shipped ``seat/data/lpv_scheduled.json`` is ``save_scheduled_seat(path,
+design_lpv_seat_controller())`` (584 s on the shared 2-core Zen 1, 2026-12-02); a first-tier
+test re-certifies it (stability at 17 masses and both delay ends, its γ by SLICOT AB13DD,
+the file's round trip).
 """
 
 from __future__ import annotations
@@ -68,8 +73,8 @@ from scipy import optimize
 from ..errors import ParameterError, SolverError
 from ..lti import freqresp, lft
 from ..synthesis.lpv import LpvsynResult, ScheduledController, lpvsyn
-from .augmented import SeatAugmentedPlant, SeatDesignOptions, seat_augmented_plant
-from .design import DEFAULT_DESIGN
+from .augmented import (DEFAULT_DESIGN, SeatAugmentedPlant, SeatDesignOptions,
+                        seat_augmented_plant)
 from .params import SeatParameters
 
 __all__ = [
@@ -93,7 +98,7 @@ logger = logging.getLogger(__name__)
 #: the unmeasured elements of the occupant set (issue 62), in the plant's channel order
 _ELEMENTS = ("k1", "k2", "k3", "c1", "c2", "c3")
 
-#: The µ route's weights (:data:`~.design.DEFAULT_DESIGN`) with the six unmeasured
+#: The µ route's weights (:data:`~.augmented.DEFAULT_DESIGN`) with the six unmeasured
 #: elements as complex uncertainty channels and the occupant mass fixed (it is the
 #: scheduling variable, not an uncertainty).  The channels cover ±10 % of each element,
 #: half the set's ±20 %: a trade-off knob.  Measured 2026-12-02 (5 masses, 2 D-K
