@@ -191,6 +191,9 @@ class ScheduledCheck:
         not searched).
     controller_radius : float
         Largest controller pole magnitude over the grid, rad/s.
+    loop_radius : float
+        Largest loop pole magnitude (no delay) over the performance samples, each with
+        its controller, rad/s.
     error : float or None
         The half-width the errors were drawn in (None where given).
     seconds : float
@@ -217,6 +220,7 @@ class ScheduledCheck:
     u_searched: float
     x1_searched: float
     controller_radius: float
+    loop_radius: float
     error: float | None
     seconds: float
 
@@ -231,16 +235,18 @@ def _controller(Ks, m3: float) -> control.StateSpace:
 
 
 def _road_figures(Ks, samples: OccupantSamples, estimates, delays, confirm):
-    """``ratio, u, x1, confirmed``: :func:`~.occupants.certify_occupants`' road figures
-    with each performance sample's controller at its estimate."""
-    from .refine import BumpResponse
+    """``ratio, u, x1, confirmed, loop_radius``: :func:`~.occupants.certify_occupants`'
+    road figures with each performance sample's controller at its estimate."""
+    from .refine import BumpResponse, loop_poles
     from .simulate import closed_loop_stable, simulate
 
     n, m = len(samples.performance), len(delays)
     ratio, u, x1 = (np.full((n, m), np.inf) for _ in range(3))
     controllers = [_controller(Ks, e) for e in estimates]
+    loop_radius = 0.0
     for i, (p, K) in enumerate(zip(samples.performance, controllers)):
         ok = np.array([closed_loop_stable(K, d, p) for d in delays])
+        loop_radius = max(loop_radius, float(np.max(np.abs(loop_poles(K, p)))))
         if not ok.any():
             continue
         z, ui, xi = BumpResponse(road=samples.road, delays=delays, params=p).peaks(K)
@@ -259,7 +265,7 @@ def _road_figures(Ks, samples: OccupantSamples, estimates, delays, confirm):
                      "x1": met.peak_x1}[name]
             confirmed.append((i, delays[j], name, float(table[i, j]), float(value)))
             table[i, j] = max(table[i, j], value)
-    return ratio, u, x1, tuple(confirmed)
+    return ratio, u, x1, tuple(confirmed), loop_radius
 
 
 def _at_value(Ks, occupants, m3_hat, error, delays, *, mu, search, omega, design, rng,
@@ -376,7 +382,7 @@ def certify_scheduled(Ks, samples: OccupantSamples, *, rng: np.random.Generator,
         if progress is not None and (k + 1) % 1000 == 0:
             progress(f"stability: {k + 1} of {len(samples.stability)}, "
                      f"{len(unstable)} unstable")
-    ratio, u, x1, confirmed = _road_figures(Ks, samples, est_p, delays, confirm)
+    ratio, u, x1, confirmed, loop_radius = _road_figures(Ks, samples, est_p, delays, confirm)
     nom = occupants.nominal
     Knom = _controller(Ks, float(np.clip(nom.m3, lo, hi)))
     nominal_ratio = (float(np.max(BumpResponse(road=samples.road, delays=delays, params=nom)
@@ -413,5 +419,6 @@ def certify_scheduled(Ks, samples: OccupantSamples, *, rng: np.random.Generator,
         u_searched=float(max(found["u"])) if found["u"] else math.nan,
         x1_searched=float(max(found["x1"])) if found["x1"] else math.nan,
         controller_radius=max(v.controller_radius for v in values) if values else math.nan,
+        loop_radius=loop_radius,
         error=None if errors is not None else float(error),
         seconds=time.perf_counter() - t0)
