@@ -145,7 +145,7 @@ def test_bad_input(shipped, samples):
                           grid=[80.0])
 
 
-@pytest.mark.slow  # 40 s on Zen 1 (2026-12-02): the second tier
+@pytest.mark.slow  # 317 s on Zen 1 at load 8-9 (2026-12-02): the second tier
 def test_mu_at_a_scheduling_value_is_the_sets_for_the_whole_range(shipped, samples):
     # an error that covers every mass: the set at each scheduling value is the whole
     # set, and µ is occupant_mu's on it; a smaller error certifies a subset, whose
