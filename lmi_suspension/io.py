@@ -6,6 +6,25 @@ meant for a computer also carries its discrete realization, ``Ad``, ``Bd``, ``Cd
 and the sample time ``dt`` (s). Python's ``json``
 writes floats with the shortest repr that round-trips, so loading gives back the same
 IEEE-754 numbers bit for bit.
+
+A file may hold a *scheduled* controller instead, told by its ``format``:
+
+- ``lmi_suspension.gridded_controller/1``
+  (:class:`~lmi_suspension.lti.gridded.GriddedController`): ``names`` (the scheduling
+  parameters), ``axes`` (each one's node values, increasing), ``inputs``, ``outputs``,
+  ``interpolation`` (``"multilinear"``), ``controllers`` (one per node, in the order of
+  :func:`itertools.product` over the axes: ``p``, the node as ``{name: value}``, and
+  ``A``, ``B``, ``C``, ``D`` as above) and ``metadata``.  ``K.at(m3=42.0)`` interpolates
+  the matrices between the nodes; a reader without this package has every node's
+  controller in the file.
+- ``lmi_suspension.scheduled_controller/1`` (:func:`~lmi_suspension.lpv.lpvsyn`'s
+  :class:`~lmi_suspension.lpv.ScheduledController`) and
+  ``lmi_suspension.polytopic_controller/1`` (:func:`~lmi_suspension.lpv.hinfgs`'s):
+  see :func:`scheduled_to_dict`.
+
+:func:`load_controller` returns whichever the file holds, first in its tuple; every
+scheduled controller offers ``names``, ``bounds`` and ``at(**p)``, a python-control
+``StateSpace``, and loads exactly (its ``at`` bit for bit at every node).
 """
 
 from __future__ import annotations
@@ -168,17 +187,38 @@ def save_controller(path, K, *, inputs=None, outputs=None, metadata=None,
     return path
 
 
-def load_controller(path) -> tuple[control.StateSpace, dict]:
-    """Read a controller written by :func:`save_controller`.
+def load_controller(path) -> tuple:
+    """Read a controller written by :func:`save_controller` or, when the file holds a
+    scheduled controller (its ``format`` is one of :data:`SCHEDULED_FORMATS`), by
+    :func:`save_scheduled_controller`.
 
     Returns
     -------
-    K : control.StateSpace
-        The controller, bit-for-bit equal to the saved one.
+    K : control.StateSpace or scheduled controller
+        The controller, bit-for-bit equal to the saved one; a scheduled controller
+        (:class:`~lmi_suspension.lti.gridded.GriddedController`,
+        :class:`~lmi_suspension.lpv.ScheduledController` or
+        :class:`~lmi_suspension.lpv.PolytopicController`) gives the controller at the
+        parameters' values with ``K.at(m3=...)``.
     metadata : dict
         The saved metadata.
+
+    Examples
+    --------
+    >>> import control, tempfile, pathlib
+    >>> from lmi_suspension.lti.gridded import GriddedController
+    >>> K = GriddedController.from_controllers(
+    ...     {"m3": [30.0, 70.0]}, [control.ss([], [], [], [[0.0, -1e4]]),
+    ...                            control.ss([], [], [], [[0.0, -3e4]])],
+    ...     inputs=["x1", "x3"], outputs=["u"])
+    >>> path = save_scheduled_controller(pathlib.Path(tempfile.mkdtemp()) / "K.json", K)
+    >>> K2, meta = load_controller(path)
+    >>> K2.names, K2.at(m3=40.0).D
+    (('m3',), array([[     0., -15000.]]))
     """
     data = _read(path)
+    if data.get("format") in SCHEDULED_FORMATS:
+        return scheduled_from_dict(data), dict(data.get("metadata", {}))
     return controller_from_dict(data), dict(data.get("metadata", {}))
 
 
@@ -281,6 +321,10 @@ def _json_default(obj):
 SCHEDULED_FORMAT = "lmi_suspension.scheduled_controller/1"
 #: :func:`~lmi_suspension.lpv.hinfgs`'s controller: the box and the vertex controllers
 POLYTOPIC_FORMAT = "lmi_suspension.polytopic_controller/1"
+#: :class:`~lmi_suspension.lti.gridded.GriddedController`: controllers at grid nodes
+GRIDDED_FORMAT = "lmi_suspension.gridded_controller/1"
+#: the formats :func:`load_controller` reads as a scheduled controller
+SCHEDULED_FORMATS = (SCHEDULED_FORMAT, POLYTOPIC_FORMAT, GRIDDED_FORMAT)
 
 
 def scheduled_to_dict(K, *, table=None, frozen: bool = True, metadata=None) -> dict:
@@ -290,7 +334,10 @@ def scheduled_to_dict(K, *, table=None, frozen: bool = True, metadata=None) -> d
     :class:`~lmi_suspension.lpv.PolytopicController` of ``hinfgs`` (or its
     ``HinfgsResult``), format ``lmi_suspension.polytopic_controller/1``: the box, the
     vertices, the level and each vertex controller's ``A``, ``B``, ``C``, ``D``
-    (``table`` and ``frozen`` do not apply: the vertex controllers are the data).
+    (``table`` and ``frozen`` do not apply: the vertex controllers are the data); or a
+    :class:`~lmi_suspension.lti.gridded.GriddedController`, format
+    ``lmi_suspension.gridded_controller/1`` (see the module docstring; the node
+    controllers are the data).
 
     The description holds everything :meth:`ScheduledController.at` needs (the
     Lyapunov coefficients ``X_i``, ``Y_i``, the scalings, the plant and basis as tables:
@@ -311,9 +358,15 @@ def scheduled_to_dict(K, *, table=None, frozen: bool = True, metadata=None) -> d
     >>> bool(np.array_equal(K2.at(m=2.5).A, K.at(m=2.5).A))       # a table node
     True
     """
+    from .lti.gridded import GriddedController
     from .synthesis.hinfgs import PolytopicController
 
     metadata = dict(metadata or {})
+    if isinstance(K, GriddedController):
+        if table is not None:
+            raise InputError("a gridded controller has no tables: it is saved exactly by "
+                             "its node controllers")
+        return {"format": GRIDDED_FORMAT, **K.to_dict(), "metadata": metadata}
     if hasattr(K, "K") and hasattr(K, "gamma_check"):        # an LpvsynResult, HinfgsResult
         metadata = {"gamma": float(K.gamma), "gamma_lmi": float(K.gamma_lmi), **metadata}
         K = K.K
@@ -339,17 +392,21 @@ def scheduled_to_dict(K, *, table=None, frozen: bool = True, metadata=None) -> d
 
 def scheduled_from_dict(data: dict):
     """The :class:`~lmi_suspension.lpv.ScheduledController` (or
-    :class:`~lmi_suspension.lpv.PolytopicController`) of :func:`scheduled_to_dict`
+    :class:`~lmi_suspension.lpv.PolytopicController`, or
+    :class:`~lmi_suspension.lti.gridded.GriddedController`) of :func:`scheduled_to_dict`
     (exactly)."""
+    from .lti.gridded import GriddedController
     from .synthesis.hinfgs import PolytopicController
     from .synthesis.lpv import ScheduledController
 
     fmt = data.get("format") if isinstance(data, dict) else None
+    if fmt == GRIDDED_FORMAT:
+        return GriddedController.from_dict(data)
     if fmt == POLYTOPIC_FORMAT:
         return PolytopicController.from_dict(data)
     if fmt != SCHEDULED_FORMAT:
-        raise InputError(f"not a scheduled controller description (format "
-                         f"{SCHEDULED_FORMAT!r} or {POLYTOPIC_FORMAT!r})")
+        raise InputError(f"not a scheduled controller description (format one of "
+                         f"{SCHEDULED_FORMATS})")
     return ScheduledController.from_dict(data)
 
 

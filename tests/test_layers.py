@@ -150,7 +150,8 @@ def test_no_import_runs_up_a_floor(graph):
 SEAT_FLOORS = (
     ("params", "model", "roads", "comfort", "weights", "simulate", "limit", "uncertainty",
      "augmented", "sampled"),
-    ("loop", "goals", "mucheck", "occupants", "worstcase", "scheduled_lpv"),
+    ("loop", "goals", "mucheck", "occupants", "worstcase", "scheduled_lpv", "occupant_subset",
+     "scheduled"),
     ("record",),
     ("design", "constrained", "bounded", "discrete_design", "refine", "multimodel"),
     ("routes",),
