@@ -414,13 +414,13 @@ def test_the_seat_requirements_certify_their_search_figures():
         PoleDisk,
         PoleShape,
         SeatLoops,
-        SeatSeat,
+        DesignSeat,
     )
     from lmi_suspension.tune import ClosedLoop, tunable_modal
 
     K = modal_form(load_refined()[0], 1900.0)
     # the two ends of the delay range (two time simulations keep the test short)
-    loops = SeatLoops([SeatSeat(BumpResponse(delays=(0.0, 0.025)), 1.0, None, None)],
+    loops = SeatLoops([DesignSeat(BumpResponse(delays=(0.0, 0.025)), 1.0, None, None)],
                       TwoBlockMu(DEFAULT_DESIGN, refine._MU_GRID))
     block = tunable_modal("K", K, pole_bounds=(1e-3, 1900.0))
     aug = seat_augmented_plant(DEFAULT_DESIGN)

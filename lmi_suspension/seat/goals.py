@@ -39,8 +39,8 @@ import numpy as np
 from ..errors import DimensionError
 from .loop import TwoBlockMu, loop_poles
 
-__all__ = ["MIN_DAMPING", "MIN_DECAY", "BumpForce", "BumpPeak", "BumpStroke", "MuBound",
-           "PoleDisk", "PoleShape", "SeatLoops", "SeatSeat"]
+__all__ = ["MIN_DAMPING", "MIN_DECAY", "BumpForce", "BumpPeak", "BumpStroke", "DesignSeat",
+           "MuBound", "PoleDisk", "PoleShape", "SeatLoops"]
 
 #: every loop pole's real part below minus this (rad/s), so that the FFT record decays
 #: (see :data:`~.loop._FFT_HORIZON`); the µ controller's slowest is 0.66
@@ -92,7 +92,7 @@ def _cover_points(mu: TwoBlockMu, K, poles: np.ndarray) -> list:
 
 
 @dataclass(frozen=True)
-class SeatSeat:
+class DesignSeat:
     """One seat the requirements are evaluated at: its bump response, the unit of its
     peak ``|z̈3|`` (1: m/s²; or its own limit), its parameters and its delay cover's
     :class:`~.loop.TwoBlockMu` (None at the design seat, whose µ is :class:`SeatLoops`')."""
@@ -119,7 +119,7 @@ class SeatLoops:
 
     Parameters
     ----------
-    seats : sequence of SeatSeat
+    seats : sequence of DesignSeat
         The design seat first.
     mu : TwoBlockMu
         The design seat's µ over the delay cover and the performance block.

@@ -54,7 +54,7 @@ from .goals import (
     PoleDisk,
     PoleShape,
     SeatLoops,
-    SeatSeat,
+    DesignSeat,
 )
 from .loop import _LIMIT_DT, REFINE_DELAYS, BumpResponse, TwoBlockMu
 from .params import SeatParameters
@@ -371,12 +371,12 @@ def _seats(opts: RefineOptions, design: SeatDesignOptions, params, road) -> list
     road = bump() if road is None else road
     delays = tuple(opts.delays)
     if not opts.plants:
-        return [SeatSeat(BumpResponse(road=road, delays=delays, params=params), 1.0, params,
+        return [DesignSeat(BumpResponse(road=road, delays=delays, params=params), 1.0, params,
                          None)]
     seats = []
     for k, p in enumerate((params,) + opts.plants):
         limit = bump_limit(road, p, dt=_LIMIT_DT).certified_peak
-        seats.append(SeatSeat(BumpResponse(road=road, delays=delays, params=p), float(limit),
+        seats.append(DesignSeat(BumpResponse(road=road, delays=delays, params=p), float(limit),
                               p, None if k == 0 else TwoBlockMu(design, _MU_GRID, p)))
     return seats
 
