@@ -40,11 +40,46 @@ import numpy as np
 from ..errors import DimensionError, InputError, ParameterError
 from .checks import as_statespace, finite_scalar
 
-__all__ = ["GriddedController"]
+__all__ = ["GriddedController", "parameter_values"]
 
 #: a value this close (relative) beyond a range's end counts as the end: a mass computed
 #: as ``30 + 40 * 1.0`` may land an ulp outside the node it means
 _RANGE_RTOL = 1e-12
+
+
+def parameter_values(names, bounds, args, named, what: str = "the range") -> tuple:
+    """Values of the parameters ``names`` given by position (``args``) or by name
+    (``named``), as floats in the order of ``names``: every one given once, finite and
+    inside its ``(lo, hi)`` of ``bounds`` (within ``_RANGE_RTOL``).  The one check of a
+    scheduled controller's point (:class:`GriddedController` here, lpvsyn's
+    ``ScheduledController``); ``what`` names the range in the error.
+
+    Raises
+    ------
+    ParameterError
+        Both ways at once, a missing or unknown name, a wrong count, a value outside.
+    NonFiniteError
+        NaN or infinity.
+    """
+    if args and named:
+        raise ParameterError("give the parameter values by position or by name, not both")
+    if named:
+        unknown = [k for k in named if k not in names]
+        missing = [k for k in names if k not in named]
+        if unknown or missing:
+            raise ParameterError(f"the schedule's parameters are {tuple(names)}; "
+                                 + (f"unknown {unknown}" if unknown else "")
+                                 + ("; " if unknown and missing else "")
+                                 + (f"missing {missing}" if missing else ""))
+        args = tuple(named[n] for n in names)
+    if len(args) != len(names):
+        raise ParameterError(f"expected {len(names)} values {tuple(names)}, got {len(args)}")
+    p = tuple(finite_scalar(v, f"parameter {n}") for n, v in zip(names, args))
+    for n, v, (lo, hi) in zip(names, p, bounds):
+        tol = _RANGE_RTOL * max(1.0, abs(lo), abs(hi))
+        if not lo - tol <= v <= hi + tol:
+            raise ParameterError(f"{n} = {v:g} is outside {what} [{lo:g}, {hi:g}]")
+    return p
 
 
 def _floats(M) -> list:
@@ -151,27 +186,7 @@ class GriddedController:
         NonFiniteError
             NaN or infinity.
         """
-        if args and named:
-            raise ParameterError("give the parameter values by position or by name, not both")
-        if named:
-            unknown = [k for k in named if k not in self.names]
-            missing = [k for k in self.names if k not in named]
-            if unknown or missing:
-                raise ParameterError(f"the schedule's parameters are {self.names}; "
-                                     + (f"unknown {unknown}" if unknown else "")
-                                     + ("; " if unknown and missing else "")
-                                     + (f"missing {missing}" if missing else ""))
-            args = tuple(named[n] for n in self.names)
-        if len(args) != len(self.names):
-            raise ParameterError(f"expected {len(self.names)} values {self.names}, got "
-                                 f"{len(args)}")
-        p = tuple(finite_scalar(v, f"parameter {n}") for n, v in zip(self.names, args))
-        for n, v, (lo, hi) in zip(self.names, p, self.bounds):
-            tol = _RANGE_RTOL * max(1.0, abs(lo), abs(hi))
-            if not lo - tol <= v <= hi + tol:
-                raise ParameterError(f"{n} = {v:g} is outside the schedule's range "
-                                     f"[{lo:g}, {hi:g}]")
-        return p
+        return parameter_values(self.names, self.bounds, args, named, "the schedule's range")
 
     def _cell(self, p) -> list:
         """Per axis ``(index, weight)``: ``p`` lies ``weight`` of the way from node

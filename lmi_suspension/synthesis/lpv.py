@@ -70,6 +70,7 @@ import numpy as np
 from ..errors import (DimensionError, InfeasibleError, InputError, NonFiniteError,
                       NyquistError, ParameterError, SolverError)
 from ..lti.checks import as_statespace, finite_scalar
+from ..lti.gridded import parameter_values
 from ..lti.norms import hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
 from ..lti.scaling import PlantScaling, scale_plant
@@ -102,9 +103,6 @@ _COUPLING_RTOL = 1e-9
 #: relative excess of a certified frozen norm over ``(1 + backoff) γ_lmi`` reported in
 #: ``warnings`` (roundoff of hinfnorm, whose own tolerance is 1e-9)
 _CERT_RTOL = 1e-6
-#: relative tolerance on a parameter value outside the design interval (roundoff of a
-#: caller's linspace)
-_RANGE_RTOL = 1e-12
 
 
 # --------------------------------------------------------------------------- input
@@ -435,22 +433,7 @@ class ScheduledController:
 
     def values(self, *args, **named) -> tuple:
         """The parameter values as a tuple in the order of ``names`` (checked)."""
-        if args and named:
-            raise ParameterError("give the parameter values by position or by name, not both")
-        if named:
-            if set(named) != set(self.names):
-                raise ParameterError(f"expected values of {self.names}, got {tuple(named)}")
-            args = tuple(named[n] for n in self.names)
-        if len(args) != len(self.names):
-            raise ParameterError(f"expected {len(self.names)} values {self.names}, got "
-                                 f"{len(args)}")
-        p = tuple(finite_scalar(v, f"parameter {n}") for n, v in zip(self.names, args))
-        for n, v, (lo, hi) in zip(self.names, p, self.bounds):
-            tol = _RANGE_RTOL * max(1.0, abs(lo), abs(hi))
-            if not lo - tol <= v <= hi + tol:
-                raise ParameterError(f"{n} = {v:g} is outside the design interval "
-                                     f"[{lo:g}, {hi:g}]")
-        return p
+        return parameter_values(self.names, self.bounds, args, named, "the design interval")
 
     def lyapunov(self, *args, **named) -> tuple[np.ndarray, np.ndarray]:
         """``(X(p), Y(p))`` of the scaled plant."""
