@@ -310,6 +310,43 @@ class OccupantCheck:
     seconds: float
 
 
+def road_figures(controllers, samples: OccupantSamples, delays, confirm: int):
+    """``(ratio, u, x1, confirmed, loop_radius)`` of the performance samples, the ``i``-th
+    with ``controllers[i]`` (one controller for all in :func:`certify_occupants`, each
+    at its estimated mass in :func:`~.scheduled.certify_scheduled`): the bump figures
+    per sample and delay (``inf`` where that loop is unstable), the ``confirm`` worst of
+    each re-simulated by time stepping (the exact delay, no clip) and raised to it."""
+    from .loop import BumpResponse, loop_poles
+    from .simulate import closed_loop_stable, simulate
+
+    road = samples.road
+    n, m = len(samples.performance), len(delays)
+    ratio, u, x1 = (np.full((n, m), np.inf) for _ in range(3))
+    loop_radius = 0.0
+    for i, (p, K) in enumerate(zip(samples.performance, controllers)):
+        ok = np.array([closed_loop_stable(K, d, p) for d in delays])
+        loop_radius = max(loop_radius, float(np.max(np.abs(loop_poles(K, p)))))
+        if not ok.any():
+            continue
+        z, ui, xi = BumpResponse(road=road, delays=delays, params=p).peaks(K)
+        ratio[i, ok] = z[ok] / samples.limits[i]
+        u[i, ok], x1[i, ok] = ui[ok], xi[ok]
+    confirmed = []
+    for name, table in (("ratio", ratio), ("u", u), ("x1", x1)):
+        finite = np.where(np.isfinite(table), table, -np.inf)
+        for flat in np.argsort(-finite, axis=None, kind="stable")[:confirm]:
+            i, j = divmod(int(flat), m)
+            if not np.isfinite(table[i, j]):
+                continue
+            met = simulate(controllers[i], road, delay=delays[j],
+                           params=samples.performance[i], u_max=np.inf).metrics()
+            value = {"ratio": met.peak_z3dd / samples.limits[i], "u": met.peak_u_command,
+                     "x1": met.peak_x1}[name]
+            confirmed.append((i, delays[j], name, float(table[i, j]), float(value)))
+            table[i, j] = max(table[i, j], value)
+    return ratio, u, x1, tuple(confirmed), loop_radius
+
+
 def certify_occupants(K, samples: OccupantSamples, *, delays=None, confirm: int = 3,
                       progress: Callable[[str], None] | None = None) -> OccupantCheck:
     """Stability and road figures of a seat controller over the samples of a set.
@@ -331,8 +368,8 @@ def certify_occupants(K, samples: OccupantSamples, *, delays=None, confirm: int 
     -------
     OccupantCheck
     """
-    from .loop import REFINE_DELAYS, BumpResponse, loop_poles
-    from .simulate import closed_loop_stable, simulate
+    from .loop import REFINE_DELAYS, BumpResponse
+    from .simulate import closed_loop_stable
 
     t0 = time.perf_counter()
     if not isinstance(samples, OccupantSamples):
@@ -353,31 +390,8 @@ def certify_occupants(K, samples: OccupantSamples, *, delays=None, confirm: int 
             progress(f"stability: {k + 1} of {len(samples.stability)}, "
                      f"{len(unstable)} unstable")
     road = samples.road
-    n, m = len(samples.performance), len(delays)
-    ratio, u, x1 = (np.full((n, m), np.inf) for _ in range(3))
-    loop_radius = 0.0
-    for i, p in enumerate(samples.performance):
-        ok = np.array([closed_loop_stable(K, d, p) for d in delays])
-        loop_radius = max(loop_radius, float(np.max(np.abs(loop_poles(K, p)))))
-        if not ok.any():
-            continue
-        z, ui, xi = BumpResponse(road=road, delays=delays, params=p).peaks(K)
-        ratio[i, ok] = z[ok] / samples.limits[i]
-        u[i, ok], x1[i, ok] = ui[ok], xi[ok]
-    # the worst of each figure re-simulated by time stepping (the exact delay, no clip)
-    confirmed = []
-    for name, table in (("ratio", ratio), ("u", u), ("x1", x1)):
-        finite = np.where(np.isfinite(table), table, -np.inf)
-        for flat in np.argsort(-finite, axis=None, kind="stable")[:confirm]:
-            i, j = divmod(int(flat), m)
-            if not np.isfinite(table[i, j]):
-                continue
-            met = simulate(K, road, delay=delays[j], params=samples.performance[i],
-                           u_max=np.inf).metrics()
-            value = {"ratio": met.peak_z3dd / samples.limits[i], "u": met.peak_u_command,
-                     "x1": met.peak_x1}[name]
-            confirmed.append((i, delays[j], name, float(table[i, j]), float(value)))
-            table[i, j] = max(table[i, j], value)
+    n = len(samples.performance)
+    ratio, u, x1, confirmed, loop_radius = road_figures([K] * n, samples, delays, confirm)
     nom = samples.occupants.nominal
     nominal_ratio = (float(np.max(BumpResponse(road=road, delays=delays, params=nom)
                                   .peaks(K)[0])) / samples.nominal_limit
@@ -394,7 +408,7 @@ def certify_occupants(K, samples: OccupantSamples, *, delays=None, confirm: int 
         x1_peak=x1, worst_ratio=worst[0], worst_sample=worst[1], worst_delay=worst[2],
         u_max=float(np.max(u, initial=-np.inf)), x1_max=float(np.max(x1, initial=-np.inf)),
         nominal_ratio=nominal_ratio,
-        confirmed=tuple(confirmed),
+        confirmed=confirmed,
         controller_radius=float(np.max(np.abs(np.linalg.eigvals(K.A)), initial=0.0)),
         loop_radius=loop_radius, seconds=time.perf_counter() - t0)
 

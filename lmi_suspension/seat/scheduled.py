@@ -54,7 +54,7 @@ import numpy as np
 
 from ..errors import DimensionError, ParameterError
 from .occupant_subset import OccupantSubset
-from .occupants import MixedMuCheck, OccupantSamples, OccupantSet
+from .occupants import MixedMuCheck, OccupantSamples, OccupantSet, road_figures
 
 __all__ = ["ScheduledCheck", "ScheduleValueCheck", "certify_scheduled", "scheduling_subset",
            "schedule_estimates"]
@@ -237,35 +237,7 @@ def _controller(Ks, m3: float) -> control.StateSpace:
 def _road_figures(Ks, samples: OccupantSamples, estimates, delays, confirm):
     """``ratio, u, x1, confirmed, loop_radius``: :func:`~.occupants.certify_occupants`'
     road figures with each performance sample's controller at its estimate."""
-    from .loop import BumpResponse, loop_poles
-    from .simulate import closed_loop_stable, simulate
-
-    n, m = len(samples.performance), len(delays)
-    ratio, u, x1 = (np.full((n, m), np.inf) for _ in range(3))
-    controllers = [_controller(Ks, e) for e in estimates]
-    loop_radius = 0.0
-    for i, (p, K) in enumerate(zip(samples.performance, controllers)):
-        ok = np.array([closed_loop_stable(K, d, p) for d in delays])
-        loop_radius = max(loop_radius, float(np.max(np.abs(loop_poles(K, p)))))
-        if not ok.any():
-            continue
-        z, ui, xi = BumpResponse(road=samples.road, delays=delays, params=p).peaks(K)
-        ratio[i, ok] = z[ok] / samples.limits[i]
-        u[i, ok], x1[i, ok] = ui[ok], xi[ok]
-    confirmed = []
-    for name, table in (("ratio", ratio), ("u", u), ("x1", x1)):
-        finite = np.where(np.isfinite(table), table, -np.inf)
-        for flat in np.argsort(-finite, axis=None, kind="stable")[:confirm]:
-            i, j = divmod(int(flat), m)
-            if not np.isfinite(table[i, j]):
-                continue
-            met = simulate(controllers[i], samples.road, delay=delays[j],
-                           params=samples.performance[i], u_max=np.inf).metrics()
-            value = {"ratio": met.peak_z3dd / samples.limits[i], "u": met.peak_u_command,
-                     "x1": met.peak_x1}[name]
-            confirmed.append((i, delays[j], name, float(table[i, j]), float(value)))
-            table[i, j] = max(table[i, j], value)
-    return ratio, u, x1, tuple(confirmed), loop_radius
+    return road_figures([_controller(Ks, e) for e in estimates], samples, delays, confirm)
 
 
 def _at_value(Ks, occupants, m3_hat, error, delays, *, mu, search, omega, design, rng,
