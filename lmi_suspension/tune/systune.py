@@ -312,15 +312,9 @@ class _Problem:
         return out
 
     def _terms(self, theta):
-        closed = []
-        for loop in self.loops:
-            try:
-                cl = ClosedLoop(loop, theta)
-            except (np.linalg.LinAlgError, IllPosedLoopError):
-                return None
-            if not cl.stable:
-                return None
-            closed.append(cl)
+        closed = _closed_loops(self, theta)
+        if closed is None:
+            return None
         out = []
         for reqs in (self.soft, self.hard):
             terms = []
@@ -478,6 +472,7 @@ def _hard_margins(r, cl, tighten):
 
 
 def _closed_loops(prob: _Problem, theta):
+    """Every model's closed loop at ``theta``; None where one is ill-posed or unstable."""
     closed = []
     for loop in prob.loops:
         try:
