@@ -16,7 +16,13 @@ A file may hold a *scheduled* controller instead, told by its ``format``:
   :func:`itertools.product` over the axes: ``p``, the node as ``{name: value}``, and
   ``A``, ``B``, ``C``, ``D`` as above) and ``metadata``.  ``K.at(m3=42.0)`` interpolates
   the matrices between the nodes; a reader without this package has every node's
-  controller in the file.
+  controller in the file.  With ``interpolation`` ``"bins"`` the table is piecewise
+  constant: ``axes`` are each parameter's bin *edges* (at least two, increasing), there
+  is one controller per bin, in the order of :func:`itertools.product` over each axis's
+  bins, each with ``bin``, its ``{name: [lo, hi]}``, instead of ``p`` (the controllers
+  of different bins may differ in state dimension); ``K.at(m3=42.0)`` is the controller
+  of the bin holding 42 (closed below, open above, the last bin closed at its top),
+  bit for bit.
 - ``lmi_suspension.scheduled_controller/1`` (:func:`~lmi_suspension.lpv.lpvsyn`'s
   :class:`~lmi_suspension.lpv.ScheduledController`) and
   ``lmi_suspension.polytopic_controller/1`` (:func:`~lmi_suspension.lpv.hinfgs`'s):

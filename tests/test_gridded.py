@@ -139,3 +139,87 @@ def test_bad_tables_are_typed_errors():
         GriddedController.from_dict({"names": ["m3"]})
     with pytest.raises(InputError, match="interpolation"):
         GriddedController.from_dict({"interpolation": "cubic"})
+
+
+# ------------------------------------------------------------ piecewise constant (bins)
+
+def _bin_table(rng):
+    # bins of different orders: never blended, so allowed
+    return GriddedController.from_controllers(
+        {"m3": [30.0, 40.0, 55.0, 70.0]},
+        [_random_ss(rng, n=3), _random_ss(rng, n=4), _random_ss(rng, n=2)],
+        inputs=["x1", "x3"], outputs=["u"], interpolation="bins")
+
+
+def test_bins_pick_the_bin_controller_unchanged():
+    # reference: the bin of a value by its definition [lo, hi) (the last one [lo, hi]),
+    # written here with plain comparisons
+    K = _bin_table(np.random.default_rng(11))
+    assert K.bounds == ((30.0, 70.0),)
+    assert K.bins == (((30.0, 40.0),), ((40.0, 55.0),), ((55.0, 70.0),))
+    assert K.nodes == ((35.0,), (47.5,), (62.5,))
+    for m in (30.0, 33.3, np.nextafter(40.0, 0.0), 40.0, 47.0, 54.999, 55.0, 61.0, 70.0,
+              np.nextafter(70.0, 71.0)):
+        ref = next(i for i, ((lo, hi),) in enumerate(K.bins)
+                   if lo <= m < hi or (i == len(K.bins) - 1 and m >= lo))
+        assert K.bin_index(m3=m) == ref
+        assert _same(K.at(m3=m), K.controllers[ref])        # bit for bit
+    assert K.at(m3=40.0).nstates == 4 and K.at(m3=39.0).nstates == 3
+    assert K.at(m3=50.0).input_labels == ["x1", "x3"]
+
+
+def test_bins_in_two_parameters_follow_the_product_order():
+    rng = np.random.default_rng(12)
+    Ks = [_random_ss(rng) for _ in range(6)]
+    K = GriddedController.from_controllers({"m3": [30.0, 50.0, 70.0],
+                                            "k1": [0.8, 0.9, 1.1, 1.2]}, Ks,
+                                           interpolation="bins")
+    # itertools.product over (m3 bins) x (k1 bins): index = i_m3 * 3 + i_k1
+    assert _same(K.at(m3=31.0, k1=0.85), Ks[0])
+    assert _same(K.at(m3=31.0, k1=1.15), Ks[2])
+    assert _same(K.at(m3=60.0, k1=1.0), Ks[4])
+    assert K.bins[4] == ((50.0, 70.0), (0.9, 1.1))
+
+
+def test_bins_file_round_trip_is_exact(tmp_path):
+    K = _bin_table(np.random.default_rng(13))
+    path = save_scheduled_controller(tmp_path / "bins.json", K, metadata={"made": "test"})
+    data = json.loads(path.read_text())
+    assert data["format"] == GRIDDED_FORMAT and data["interpolation"] == "bins"
+    assert [c["bin"] for c in data["controllers"]] == [{"m3": [30.0, 40.0]},
+                                                       {"m3": [40.0, 55.0]},
+                                                       {"m3": [55.0, 70.0]}]
+    K2, meta = load_controller(path)
+    assert isinstance(K2, GriddedController) and K2.interpolation == "bins"
+    assert meta == {"made": "test"}
+    assert all(np.array_equal(a, b) for a, b in zip(K2.axes, K.axes))
+    for a, b in zip(K2.controllers, K.controllers):
+        assert _same(a, b)
+    # written again, the same text
+    again = save_scheduled_controller(tmp_path / "again.json", K2, metadata={"made": "test"})
+    assert again.read_text() == path.read_text()
+
+
+def test_bad_bins_are_typed_errors():
+    rng = np.random.default_rng(14)
+    K1 = _random_ss(rng)
+    with pytest.raises(ParameterError, match="at least two"):
+        GriddedController.from_controllers({"m3": [30.0]}, [K1], interpolation="bins")
+    with pytest.raises(DimensionError, match="bins"):
+        GriddedController.from_controllers({"m3": [30.0, 50.0, 70.0]}, [K1],
+                                           interpolation="bins")
+    with pytest.raises(DimensionError, match="inputs"):
+        GriddedController.from_controllers(
+            {"m3": [30.0, 50.0, 70.0]}, [K1, control.ss([[-1.0]], [[1.0]], [[1.0]], [[0.0]])],
+            interpolation="bins")
+    with pytest.raises(ParameterError, match="interpolation"):
+        GriddedController.from_controllers({"m3": [30.0, 70.0]}, [K1], interpolation="step")
+    K = _bin_table(rng)
+    with pytest.raises(ParameterError, match="outside"):
+        K.at(m3=71.0)
+    with pytest.raises(NonFiniteError):
+        K.at(m3=math.nan)
+    with pytest.raises(ParameterError, match="not bins"):
+        _mass_table(rng).bins
+    with pytest.raises(ParameterError, match="not bins"):
+        _mass_table(rng).bin_index(m3=40.0)

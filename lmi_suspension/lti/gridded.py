@@ -11,6 +11,14 @@ multilinearly between the surrounding nodes (MATLAB's gridded LPV models and
 interpolated controller is a different controller from any node's: a certificate holds
 at the values it was computed at (see :func:`~lmi_suspension.seat.scheduled.certify_scheduled`).
 
+With ``interpolation="bins"`` the table is piecewise constant instead: each axis holds a
+parameter's bin *edges*, there is one controller per bin (a cell of the edges' grid), and
+``at`` returns the controller of the bin the value falls in, unchanged (bins are closed
+below and open above, the last one closed at both ends).  A seat that measures its
+occupant's mass once, at rest, picks one controller per ride and never switches during
+it; the controllers of different bins need not share a state dimension (they are never
+blended).
+
 :mod:`lmi_suspension.io` saves it exactly (format ``lmi_suspension.gridded_controller/1``)
 and ``load_controller`` returns it.
 
@@ -23,6 +31,10 @@ Examples
 >>> K = GriddedController.from_controllers({"m3": [30.0, 70.0]}, [K30, K70])
 >>> K.at(m3=50.0).A, K.at(m3=30.0).D
 (array([[-15.]]), array([[0., 1.]]))
+>>> B = GriddedController.from_controllers({"m3": [30.0, 50.0, 70.0]}, [K30, K70],
+...                                         interpolation="bins")
+>>> B.at(m3=49.9).D, B.at(m3=50.0).D, B.bins
+(array([[0., 1.]]), array([[0., 3.]]), (((30.0, 50.0),), ((50.0, 70.0),)))
 >>> K.at(m3=80.0)
 Traceback (most recent call last):
 ...
@@ -40,7 +52,11 @@ import numpy as np
 from ..errors import DimensionError, InputError, ParameterError
 from .checks import as_statespace, finite_scalar
 
-__all__ = ["GriddedController", "parameter_values"]
+__all__ = ["GriddedController", "parameter_values", "INTERPOLATIONS"]
+
+#: how :meth:`GriddedController.at` reads its table: between nodes (``"multilinear"``) or
+#: the bin a value falls in (``"bins"``, piecewise constant over explicit edges)
+INTERPOLATIONS = ("multilinear", "bins")
 
 #: a value this close (relative) beyond a range's end counts as the end: a mass computed
 #: as ``30 + 40 * 1.0`` may land an ulp outside the node it means
@@ -88,7 +104,8 @@ def _floats(M) -> list:
 
 @dataclass(frozen=True, eq=False)
 class GriddedController:
-    """State-space controllers at the nodes of a grid, interpolated multilinearly.
+    """State-space controllers at the nodes of a grid, interpolated multilinearly, or
+    one per bin of a grid of edges (``interpolation="bins"``).
 
     Attributes
     ----------
@@ -96,12 +113,16 @@ class GriddedController:
         The scheduling parameters.
     axes : tuple of numpy.ndarray
         Each parameter's node values, strictly increasing (one value: the parameter is
-        held there).
+        held there); with bins, each parameter's bin edges (at least two).
     controllers : tuple of control.StateSpace
-        The controller at each node, in the order of :func:`itertools.product` over the
-        axes; the same numbers of states, inputs and outputs at every node.
+        The controller at each node (each bin), in the order of
+        :func:`itertools.product` over the axes (over each axis's bins); the same
+        numbers of inputs and outputs everywhere, and of states at every node of a
+        multilinear table.
     inputs, outputs : tuple of str
         Signal names.
+    interpolation : str
+        ``"multilinear"`` (default) or ``"bins"`` (:data:`INTERPOLATIONS`).
     """
 
     names: tuple
@@ -109,6 +130,7 @@ class GriddedController:
     controllers: tuple = field(repr=False)
     inputs: tuple = ()
     outputs: tuple = ()
+    interpolation: str = "multilinear"
 
     def __post_init__(self):
         if isinstance(self.names, str) or not self.names:
@@ -120,21 +142,30 @@ class GriddedController:
         if len(self.axes) != len(names):
             raise DimensionError(f"{len(self.axes)} axes for the {len(names)} parameters "
                                  f"{names}")
+        if self.interpolation not in INTERPOLATIONS:
+            raise ParameterError(f"interpolation must be one of {INTERPOLATIONS}, got "
+                                 f"{self.interpolation!r}")
+        bins = self.interpolation == "bins"
         axes = []
         for n, a in zip(names, self.axes):
             a = np.array(a, dtype=float).ravel()
-            if a.size < 1 or not np.all(np.isfinite(a)) or np.any(np.diff(a) <= 0):
-                raise ParameterError(f"the nodes of {n} must be finite and strictly "
-                                     f"increasing, got {a.tolist()}")
+            if a.size < (2 if bins else 1) or not np.all(np.isfinite(a)) \
+                    or np.any(np.diff(a) <= 0):
+                raise ParameterError(f"the {'bin edges' if bins else 'nodes'} of {n} must "
+                                     f"be finite and strictly increasing"
+                                     f"{' (at least two)' if bins else ''}, got {a.tolist()}")
             a.setflags(write=False)
             axes.append(a)
-        count = int(np.prod([a.size for a in axes]))
+        shape = tuple(a.size - 1 if bins else a.size for a in axes)
+        count = int(np.prod(shape))
         Ks = tuple(as_statespace(K, f"controller {i}") for i, K in enumerate(self.controllers))
         if len(Ks) != count:
-            raise DimensionError(f"{len(Ks)} controllers for the {count} nodes of the grid")
+            raise DimensionError(f"{len(Ks)} controllers for the {count} "
+                                 f"{'bins' if bins else 'nodes'} of the grid")
         size = (Ks[0].nstates, Ks[0].ninputs, Ks[0].noutputs)
         for i, K in enumerate(Ks):
-            if (K.nstates, K.ninputs, K.noutputs) != size:
+            # bins are never blended: only the signals must agree
+            if (K.ninputs, K.noutputs) != size[1:] or (not bins and K.nstates != size[0]):
                 raise DimensionError(f"controller {i} has (states, inputs, outputs) "
                                      f"{(K.nstates, K.ninputs, K.noutputs)}, the first {size}")
             if K.isdtime(strict=True):
@@ -149,21 +180,22 @@ class GriddedController:
         object.__setattr__(self, "controllers", Ks)
         object.__setattr__(self, "inputs", tuple(str(s) for s in inputs))
         object.__setattr__(self, "outputs", tuple(str(s) for s in outputs))
-        # the nodes' matrices stacked on the grid's shape, for the interpolation
-        shape = tuple(a.size for a in axes)
-        object.__setattr__(self, "_stack", tuple(
+        # the nodes' matrices stacked on the grid's shape, for the interpolation (bins
+        # pick a controller whole and may differ in order: no stack)
+        object.__setattr__(self, "_stack", None if bins else tuple(
             np.stack([np.asarray(getattr(K, M), dtype=float) for K in Ks]).reshape(
                 shape + np.shape(getattr(Ks[0], M))) for M in "ABCD"))
 
     @classmethod
-    def from_controllers(cls, grid: dict, controllers, *, inputs=(), outputs=()
-                         ) -> GriddedController:
-        """The table from ``{name: node values}`` and the controllers at the nodes (in
-        the order of :func:`itertools.product` over ``grid``'s values)."""
+    def from_controllers(cls, grid: dict, controllers, *, inputs=(), outputs=(),
+                         interpolation: str = "multilinear") -> GriddedController:
+        """The table from ``{name: node values}`` (with bins, ``{name: bin edges}``) and
+        the controllers at the nodes (in the bins), in the order of
+        :func:`itertools.product` over ``grid``'s values (bins)."""
         if not isinstance(grid, dict) or not grid:
             raise ParameterError("grid must be a non-empty dict {name: node values}")
         return cls(tuple(grid), tuple(grid.values()), tuple(controllers), tuple(inputs),
-                   tuple(outputs))
+                   tuple(outputs), interpolation)
 
     @property
     def bounds(self) -> tuple:
@@ -172,8 +204,46 @@ class GriddedController:
 
     @property
     def nodes(self) -> tuple:
-        """The grid's nodes, in the order of ``controllers``."""
+        """The grid's nodes, in the order of ``controllers``; with bins, each bin's
+        centre (the point per bin in that order)."""
+        if self.interpolation == "bins":
+            return tuple(tuple((lo + hi) / 2 for lo, hi in b) for b in self.bins)
         return tuple(itertools.product(*(a.tolist() for a in self.axes)))
+
+    @property
+    def bins(self) -> tuple:
+        """With bins, each bin as a tuple of ``(lo, hi)`` per parameter, in the order of
+        ``controllers``.
+
+        Raises
+        ------
+        ParameterError
+            A multilinear table (it has nodes, not bins).
+        """
+        if self.interpolation != "bins":
+            raise ParameterError("a multilinear table has nodes, not bins")
+        edges = [list(zip(a[:-1].tolist(), a[1:].tolist())) for a in self.axes]
+        return tuple(itertools.product(*edges))
+
+    def bin_index(self, *args, **named) -> int:
+        """With bins, the index in ``controllers`` of the bin holding the value (checked
+        as :meth:`values`): closed below, open above, the last bin closed at its top.
+
+        Raises
+        ------
+        ParameterError
+            A multilinear table, or a value :meth:`values` refuses.
+        """
+        if self.interpolation != "bins":
+            raise ParameterError("a multilinear table has nodes, not bins")
+        p = self.values(*args, **named)
+        index = 0
+        for v, a in zip(p, self.axes):
+            # side="right" puts an edge into the bin above it; the top edge (and a value
+            # an ulp beyond, which values() admits) into the last bin
+            i = int(np.clip(np.searchsorted(a, v, side="right") - 1, 0, a.size - 2))
+            index = index * (a.size - 1) + i
+        return index
 
     def values(self, *args, **named) -> tuple:
         """The parameter values as a tuple in the order of ``names``, checked: a value
@@ -201,7 +271,12 @@ class GriddedController:
     def at(self, *args, **named) -> control.StateSpace:
         """The controller at one value of the scheduling parameters (``K.at(m3=42.0)``):
         at a node, that node's matrices bit for bit; between nodes, ``a + w (b - a)``
-        along each axis in turn."""
+        along each axis in turn.  With bins, the controller of the value's bin
+        (:meth:`bin_index`), its matrices bit for bit."""
+        if self.interpolation == "bins":
+            K = self.controllers[self.bin_index(*args, **named)]
+            return control.ss(*(np.array(getattr(K, M), dtype=float) for M in "ABCD"),
+                              inputs=list(self.inputs), outputs=list(self.outputs), name="K")
         cell = self._cell(self.values(*args, **named))
         mats = []
         for M in self._stack:
@@ -215,15 +290,18 @@ class GriddedController:
     def to_dict(self) -> dict:
         """JSON-ready description (every float a Python float, which :mod:`json` writes
         as its shortest round-tripping repr: :meth:`from_dict` is exact)."""
+        bins = self.interpolation == "bins"
+        where = ([dict(zip(self.names, ([lo, hi] for lo, hi in b))) for b in self.bins]
+                 if bins else [dict(zip(self.names, node)) for node in self.nodes])
         return {
             "names": list(self.names),
             "axes": [_floats(a) for a in self.axes],
             "inputs": list(self.inputs), "outputs": list(self.outputs),
-            "interpolation": "multilinear",
-            "controllers": [{"p": dict(zip(self.names, node)),
+            "interpolation": self.interpolation,
+            "controllers": [{"bin" if bins else "p": w,
                              "A": _floats(K.A), "B": _floats(K.B), "C": _floats(K.C),
                              "D": _floats(K.D)}
-                            for node, K in zip(self.nodes, self.controllers)],
+                            for w, K in zip(where, self.controllers)],
         }
 
     @classmethod
@@ -236,8 +314,9 @@ class GriddedController:
             A missing key, an unknown interpolation, or matrices that do not fit.
         """
         try:
-            if data.get("interpolation", "multilinear") != "multilinear":
-                raise InputError(f"unknown interpolation {data['interpolation']!r}")
+            interpolation = data.get("interpolation", "multilinear")
+            if interpolation not in INTERPOLATIONS:
+                raise InputError(f"unknown interpolation {interpolation!r}")
             names = tuple(str(n) for n in data["names"])
             axes = tuple(np.asarray(a, dtype=float) for a in data["axes"])
             inputs, outputs = tuple(data["inputs"]), tuple(data["outputs"])
@@ -255,4 +334,4 @@ class GriddedController:
             if isinstance(exc, InputError):
                 raise
             raise InputError(f"malformed gridded controller description: {exc}") from exc
-        return cls(names, axes, tuple(Ks), inputs, outputs)
+        return cls(names, axes, tuple(Ks), inputs, outputs, interpolation)

@@ -26,6 +26,12 @@ measures one controller, and more:
   certifies stability of every such seat) and the worst-seat search for force and stroke
   (:func:`~.worstcase.worst_bump_seats`).
 
+A table of bins (``GriddedController(interpolation="bins")``: one controller per bin of
+the estimated mass, picked once per ride) is certified per *bin*: the controller of a
+bin of estimates ``[a, b]`` meets the true masses ``[a - error, b + error]``
+(``scheduling_subset(occupants, (a, b), error)``), and that is the set its µ and its
+search cover.
+
 With one controller at every mass (``GriddedController`` of equal nodes) the sampled
 figures are :func:`~.occupants.certify_occupants`' on the same samples, bit for bit (the
 test suite checks it).
@@ -40,6 +46,9 @@ Examples
 ((30.0, 37.0), 32.0)
 >>> scheduling_subset(OccupantSet(), 50.0, 0.0).fixed
 ('m3',)
+>>> b = scheduling_subset(OccupantSet(), (40.0, 50.0), 5.0)
+>>> b.m3, b.nominal.m3
+((35.0, 55.0), 45.0)
 """
 
 from __future__ import annotations
@@ -63,28 +72,47 @@ __all__ = ["ScheduledCheck", "ScheduleValueCheck", "certify_scheduled", "schedul
 _MASS = "m3"
 
 
-def scheduling_subset(occupants: OccupantSet, m3_hat: float, error: float) -> OccupantSubset:
+def _estimate_interval(m3_hat) -> tuple[float, float]:
+    """``(a, b)`` of an estimate (a number: ``a == b``) or a bin of estimates (a pair)."""
+    try:
+        a, b = ((float(m3_hat),) * 2 if np.ndim(m3_hat) == 0
+                else tuple(float(v) for v in m3_hat))
+    except (TypeError, ValueError):
+        raise ParameterError(f"m3_hat must be a mass or a pair (lo, hi) of masses, got "
+                             f"{m3_hat!r}") from None
+    if not (math.isfinite(a) and math.isfinite(b) and a <= b):
+        raise ParameterError(f"m3_hat must be finite (a pair with lo <= hi), got {m3_hat!r}")
+    return a, b
+
+
+def scheduling_subset(occupants: OccupantSet, m3_hat, error: float) -> OccupantSubset:
     """The seats a controller scheduled on the estimate ``m3_hat`` may meet: true mass
     within ``m3_hat ± error`` inside the set's range (fixed at ``m3_hat`` for ``error =
-    0``), every other parameter and the delay as in ``occupants``.
+    0``), every other parameter and the delay as in ``occupants``.  With a bin of
+    estimates ``m3_hat = (a, b)`` (the controller of a piecewise-constant table serves
+    every estimate in it), the true masses ``[a - error, b + error]``, the seat of the
+    set at the bin's centre.
 
     Raises
     ------
     ParameterError
-        ``m3_hat`` outside the set's mass range, ``error`` negative or not finite.
+        ``m3_hat`` (or a bin end) outside the set's mass range, a bin with ``a > b``,
+        ``error`` negative or not finite.
     """
     if not isinstance(occupants, OccupantSet):
         raise ParameterError(f"occupants must be an OccupantSet, got "
                              f"{type(occupants).__name__}")
     lo, hi = occupants.m3
-    m, e = float(m3_hat), float(error)
-    if not (math.isfinite(m) and lo <= m <= hi):
+    a, b = _estimate_interval(m3_hat)
+    e = float(error)
+    if not (lo <= a and b <= hi):
         raise ParameterError(f"m3_hat = {m3_hat!r} is outside the set's masses [{lo:g}, {hi:g}]")
     if not (math.isfinite(e) and e >= 0):
         raise ParameterError(f"error must be finite and >= 0 kg, got {error!r}")
+    m = a if a == b else (a + b) / 2
     fixed = tuple(n for n in getattr(occupants, "fixed", ()) if n != _MASS)
     return OccupantSubset(nominal=replace(occupants.nominal, m3=m),
-                          m3=(max(lo, m - e), min(hi, m + e)),
+                          m3=(max(lo, a - e), min(hi, b + e)),
                           stiffness_rel=occupants.stiffness_rel,
                           damping_rel=occupants.damping_rel, delay=occupants.delay,
                           fixed=fixed)
@@ -139,7 +167,7 @@ class ScheduleValueCheck:
     Attributes
     ----------
     m3_hat : float
-        The estimate the controller is scheduled on, kg.
+        The estimate the controller is scheduled on, kg (a bin's centre).
     occupants : OccupantSubset
         The seats it may meet (:func:`scheduling_subset`).
     mu : MixedMuCheck or None
@@ -151,6 +179,8 @@ class ScheduleValueCheck:
         The largest force and stroke found over them (empty when not searched).
     controller_radius : float
         Largest pole magnitude of the controller there, rad/s.
+    estimates : (float, float)
+        The estimates the value stands for: ``(m3_hat, m3_hat)``, or a bin's ends.
     """
 
     m3_hat: float
@@ -159,6 +189,7 @@ class ScheduleValueCheck:
     rs_mu: float
     worst_seats: tuple
     controller_radius: float
+    estimates: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -246,8 +277,15 @@ def _at_value(Ks, occupants, m3_hat, error, delays, *, mu, search, omega, design
     from .occupants import occupant_mu
     from .worstcase import worst_bump_seats
 
-    K = _controller(Ks, m3_hat)
-    subset = scheduling_subset(occupants, m3_hat, error)
+    a, b = _estimate_interval(m3_hat)
+    K = _controller(Ks, (a + b) / 2)
+    if a < b and getattr(Ks, "interpolation", None) == "bins":
+        # one controller serves the whole bin: it must be the one at each end too
+        # (the top edge belongs to the next bin, so the check is just below it)
+        if not all(Ks.bin_index(**{_MASS: v}) == Ks.bin_index(**{_MASS: (a + b) / 2})
+                   for v in (a, b - 1e-9 * max(1.0, abs(b)))):
+            raise ParameterError(f"the estimates [{a:g}, {b:g}] are not one bin of Ks")
+    subset = scheduling_subset(occupants, (a, b), error)
     check, rs = None, math.nan
     if mu:
         try:
@@ -258,8 +296,9 @@ def _at_value(Ks, occupants, m3_hat, error, delays, *, mu, search, omega, design
     worst = (worst_bump_seats(K, subset, rng=rng, n=search_n, delays=delays,
                               road=road) if search else ())
     radius = float(np.max(np.abs(np.linalg.eigvals(K.A)), initial=0.0))
-    return ScheduleValueCheck(m3_hat=float(m3_hat), occupants=subset, mu=check, rs_mu=rs,
-                              worst_seats=tuple(worst), controller_radius=radius)
+    return ScheduleValueCheck(m3_hat=(a + b) / 2, occupants=subset, mu=check, rs_mu=rs,
+                              worst_seats=tuple(worst), controller_radius=radius,
+                              estimates=(a, b))
 
 
 def certify_scheduled(Ks, samples: OccupantSamples, *, rng: np.random.Generator,
@@ -290,7 +329,9 @@ def certify_scheduled(Ks, samples: OccupantSamples, *, rng: np.random.Generator,
         draws); ``error`` still sets the sets of the grid.
     grid : array_like, optional
         The scheduling values of µ and the search (by default 9 over the schedule's
-        range).
+        range; for a table of bins, ``Ks.bins``); a value may be a bin of estimates
+        ``(lo, hi)`` of a table of bins, certified over
+        ``scheduling_subset(occupants, (lo, hi), error)``.
     delays : sequence of float, optional
         Delays of the road requirements (0, 5, …, 25 ms by default).
     confirm : int
@@ -331,11 +372,21 @@ def certify_scheduled(Ks, samples: OccupantSamples, *, rng: np.random.Generator,
     if not delays or any(not math.isfinite(d) or d < 0 for d in delays):
         raise ParameterError(f"delays must be finite and non-negative, got {delays!r}")
     occupants = samples.occupants
-    grid = (np.linspace(max(lo, occupants.m3[0]), min(hi, occupants.m3[1]), 9)
-            if grid is None else np.asarray(grid, dtype=float).ravel())
+    if grid is None and getattr(Ks, "interpolation", None) == "bins":
+        # a bin's ends clipped to the set's masses (the table may reach beyond them)
+        grid = [(max(b[0][0], occupants.m3[0]), min(b[0][1], occupants.m3[1]))
+                for b in Ks.bins if b[0][1] > occupants.m3[0] and b[0][0] < occupants.m3[1]]
+    elif grid is None:
+        grid = np.linspace(max(lo, occupants.m3[0]), min(hi, occupants.m3[1]), 9).tolist()
+    else:
+        grid = [g if np.ndim(g) else float(g) for g in
+                (grid if isinstance(grid, (list, tuple)) else np.asarray(grid, dtype=float)
+                 .tolist())]
     for m in grid:                      # before the long part: a bad grid fails at once
-        Ks.values(**{_MASS: float(m)})
-        scheduling_subset(occupants, float(m), float(error))
+        a, b = _estimate_interval(m)
+        Ks.values(**{_MASS: a})
+        Ks.values(**{_MASS: b})
+        scheduling_subset(occupants, (a, b), float(error))
     true_s = [p.m3 for p in samples.stability]
     true_p = [p.m3 for p in samples.performance]
     if errors is None:
@@ -370,12 +421,12 @@ def certify_scheduled(Ks, samples: OccupantSamples, *, rng: np.random.Generator,
 
     values = []
     for m in grid:
-        values.append(_at_value(Ks, occupants, float(m), float(error), delays, mu=mu,
+        values.append(_at_value(Ks, occupants, m, float(error), delays, mu=mu,
                                 search=search, omega=omega, design=design, rng=rng,
                                 search_n=search_n, road=samples.road))
         if progress is not None:
             v = values[-1]
-            progress(f"m3_hat {m:g} kg: mixed µ {v.rs_mu:.4g}, "
+            progress(f"m3_hat {v.estimates[0]:g}-{v.estimates[1]:g} kg: mixed µ {v.rs_mu:.4g}, "
                      + ", ".join(w.describe() for w in v.worst_seats))
     rs = [v.rs_mu for v in values]
     found = {f: [w.value for v in values for w in v.worst_seats if w.figure == f]
