@@ -76,6 +76,20 @@ def test_scheduling_subset():
         scheduling_subset(OccupantSet(), 50.0, -1.0)
 
 
+def test_scheduling_subset_of_a_bin():
+    # a bin of estimates [a, b] meets the true masses [a - e, b + e] (within the set's)
+    s = scheduling_subset(OccupantSet(), (40.0, 50.0), 5.0)
+    assert s.m3 == (35.0, 55.0) and s.nominal.m3 == 45.0 and s.fixed == ()
+    assert scheduling_subset(OccupantSet(), (30.0, 40.0), 5.0).m3 == (30.0, 45.0)
+    assert scheduling_subset(OccupantSet(), (50.0, 50.0), 0.0).fixed == ("m3",)
+    with pytest.raises(ParameterError, match="lo <= hi"):
+        scheduling_subset(OccupantSet(), (50.0, 40.0), 5.0)
+    with pytest.raises(ParameterError, match="outside"):
+        scheduling_subset(OccupantSet(), (60.0, 75.0), 5.0)
+    with pytest.raises(ParameterError, match="pair"):
+        scheduling_subset(OccupantSet(), (40.0, 45.0, 50.0), 5.0)
+
+
 # ----------------------------------------------------------------------- estimates
 def test_estimates_drawn_within_the_error_and_the_range(shipped):
     Ks = _constant(shipped)
@@ -129,6 +143,30 @@ def test_the_controller_is_scheduled_on_the_estimate(shipped, samples):
     z_true = BumpResponse(road=samples.road, delays=got.delays, params=p0).peaks(
         Ks.at(m3=p0.m3))[0]
     assert not np.array_equal(got.ratio[0], z_true / samples.limits[0])
+
+
+def test_a_table_of_bins_is_certified_per_bin(shipped, samples):
+    # two bins, the second controller weaker: every sample's figures are those of the
+    # controller of its estimate's bin, computed here directly; the certificate's values
+    # are the bins, each over its estimates widened by the error
+    weak = control.ss(shipped.A, shipped.B, 0.8 * shipped.C, 0.8 * shipped.D)
+    Ks = GriddedController.from_controllers({"m3": [30.0, 50.0, 70.0]}, [shipped, weak],
+                                            interpolation="bins")
+    n_s, n_p = len(samples.stability), len(samples.performance)
+    errors = (np.full(n_s, -2.0), np.array([-5.0, 5.0, 0.0])[:n_p])
+    got = certify_scheduled(Ks, samples, rng=np.random.default_rng(0), errors=errors,
+                            confirm=0, mu=False, search=False)
+    assert [v.estimates for v in got.values] == [(30.0, 50.0), (50.0, 70.0)]
+    assert [v.occupants.m3 for v in got.values] == [(30.0, 55.0), (45.0, 70.0)]
+    assert [v.m3_hat for v in got.values] == [40.0, 60.0]
+    est = np.clip([p.m3 for p in samples.performance] + errors[1], 30.0, 70.0)
+    for i, (p, m) in enumerate(zip(samples.performance, est)):
+        K = shipped if m < 50.0 else weak
+        z = BumpResponse(road=samples.road, delays=got.delays, params=p).peaks(K)[0]
+        assert np.array_equal(got.ratio[i], z / samples.limits[i])
+    with pytest.raises(ParameterError, match="not one bin"):
+        certify_scheduled(Ks, samples, rng=np.random.default_rng(0), mu=False,
+                          search=False, grid=[(40.0, 60.0)])
 
 
 def test_bad_input(shipped, samples):

@@ -271,20 +271,30 @@ def _road_figures(Ks, samples: OccupantSamples, estimates, delays, confirm):
     return road_figures([_controller(Ks, e) for e in estimates], samples, delays, confirm)
 
 
-def _at_value(Ks, occupants, m3_hat, error, delays, *, mu, search, omega, design, rng,
-              search_n, road) -> ScheduleValueCheck:
-    """The certificate at one scheduling value."""
-    from .occupants import occupant_mu
-    from .worstcase import worst_bump_seats
-
+def _check_value(Ks, occupants, m3_hat, error) -> tuple[float, float]:
+    """``(a, b)`` of a scheduling value (a mass, or a bin of estimates of a table of
+    bins), checked against the schedule and the set."""
     a, b = _estimate_interval(m3_hat)
-    K = _controller(Ks, (a + b) / 2)
+    Ks.values(**{_MASS: a})
+    Ks.values(**{_MASS: b})
     if a < b and getattr(Ks, "interpolation", None) == "bins":
         # one controller serves the whole bin: it must be the one at each end too
         # (the top edge belongs to the next bin, so the check is just below it)
         if not all(Ks.bin_index(**{_MASS: v}) == Ks.bin_index(**{_MASS: (a + b) / 2})
                    for v in (a, b - 1e-9 * max(1.0, abs(b)))):
             raise ParameterError(f"the estimates [{a:g}, {b:g}] are not one bin of Ks")
+    scheduling_subset(occupants, (a, b), float(error))
+    return a, b
+
+
+def _at_value(Ks, occupants, m3_hat, error, delays, *, mu, search, omega, design, rng,
+              search_n, road) -> ScheduleValueCheck:
+    """The certificate at one scheduling value."""
+    from .occupants import occupant_mu
+    from .worstcase import worst_bump_seats
+
+    a, b = _check_value(Ks, occupants, m3_hat, error)
+    K = _controller(Ks, (a + b) / 2)
     subset = scheduling_subset(occupants, (a, b), error)
     check, rs = None, math.nan
     if mu:
@@ -383,10 +393,7 @@ def certify_scheduled(Ks, samples: OccupantSamples, *, rng: np.random.Generator,
                 (grid if isinstance(grid, (list, tuple)) else np.asarray(grid, dtype=float)
                  .tolist())]
     for m in grid:                      # before the long part: a bad grid fails at once
-        a, b = _estimate_interval(m)
-        Ks.values(**{_MASS: a})
-        Ks.values(**{_MASS: b})
-        scheduling_subset(occupants, (a, b), float(error))
+        _check_value(Ks, occupants, m, error)
     true_s = [p.m3 for p in samples.stability]
     true_p = [p.m3 for p in samples.performance]
     if errors is None:

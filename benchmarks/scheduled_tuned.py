@@ -1,0 +1,305 @@
+"""The seat scheduled on the occupant's measured mass along the *tuned* route (issue 62,
+item 2): a table of occupant-route designs, one per bin of the estimated mass, against
+the convex route, today's robust controller, the single-seat design and designs tuned
+for exactly one mass, on one set of samples and one search.
+
+Run (from the repository root, ``MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1 PYTHONPATH=.``)::
+
+    python benchmarks/scheduled_tuned.py                 # compare the shipped files
+    python benchmarks/scheduled_tuned.py --design        # design the table anew, then compare
+    python benchmarks/scheduled_tuned.py --quick         # 8 seats, 50 stability samples, no µ
+
+``--design`` writes ``--out`` (default ``lmi_suspension/seat/data``) ``mu_scheduled.json``
+and ``mu_at_mass.json``; ``--jobs 2`` designs two bins at a time (the machine has two
+cores); ``--bins-only`` / ``--refs-only`` design one of the two.
+
+**The scheduled design** (:func:`design_bin`): for each bin ``[a, b]`` of the estimated
+mass (edges :data:`EDGES`), the controller that serves every seat it may meet: true mass
+in ``[a - ERROR, b + ERROR]`` (:data:`ERROR` = 5 kg, the load cell's error), every other
+parameter and the delay as in the occupant set
+(:func:`~lmi_suspension.seat.scheduled.scheduling_subset` with the bin), refined by
+:func:`~lmi_suspension.seat.multimodel.refine_for_occupants` as the occupant route does
+(``RefineOptions(mu_performance=False, occupants=subset)``: the set's mixed µ of robust
+stability a requirement, the road requirements at the subset's seats and every delay)
+from ``seat/data/mu_refined.json`` with the budget of ``benchmarks/occupant_groups.py``
+(one round of :data:`MAX_ITER` SLSQP iterations, :data:`N_SEARCH` search samples) and the
+force bound :data:`U_BOUND` (below 1500 N: one round adds no searched seat, so the
+margin is what holds 1500 N between the design seats; see the note of issue 62).  The
+bins make a :class:`~lmi_suspension.lti.gridded.GriddedController` with
+``interpolation="bins"``: the mass is measured once, at rest, so the seat picks one
+controller per ride and never switches during it.
+
+**The references** (:func:`design_reference`): the same refinement with the mass fixed
+(``OccupantSubset(m3=(m, m))``, everything else as the set) at :data:`REF_MASSES`: the
+best a controller scheduled on the mass could do at that mass; shipped as a
+``GriddedController`` over ``m3`` with a node at each (only the nodes are designs).
+
+**The comparison**: every controller on the same samples (seed :data:`SAMPLE_SEED`: a
+Latin hypercube over the whole set, each seat against its own clairvoyant limit) by
+:func:`~lmi_suspension.seat.scheduled.certify_scheduled`, each scheduled controller at
+every seat's *estimated* mass (true ± 5 kg, seeded), a fixed controller at every seat:
+nominal and worst ratio, largest commanded ``|u|`` and ``|x1|`` (on the samples and at
+the worst seats the search finds per scheduling value), unstable samples, mixed µ of
+robust stability per scheduling value (per bin; over the whole set for a fixed
+controller), the fastest controller pole; then the peak ratio at the seats of
+:data:`REF_MASSES` (other parameters nominal, worst over the delays, the scheduled
+controllers at the true mass and at ±5 kg) against the reference tuned for that mass.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import replace
+from pathlib import Path
+
+import control
+import numpy as np
+
+DATA = Path(__file__).resolve().parents[1] / "lmi_suspension" / "seat" / "data"
+
+#: the bins of the estimated mass, kg
+EDGES = (30.0, 40.0, 50.0, 60.0, 70.0)
+#: the load cell's error, kg: the estimate is the true mass within ± this
+ERROR = 5.0
+#: the masses of the references tuned for exactly that mass, kg
+REF_MASSES = (30.0, 50.0, 70.0)
+#: the budget of benchmarks/occupant_groups.py (item 1's table)
+MAX_ITER, ROUNDS, N_SEARCH = 40, 1, 10
+#: the force bound at the design seats, N: a margin below 1500 N for the seats between
+U_BOUND = 1400.0
+SAMPLE_SEED, DESIGN_SEED, ESTIMATE_SEED = 62, 7, 5
+
+
+def _options(subset, max_iter, u_bound):
+    from lmi_suspension.seat.refine import RefineOptions
+
+    return RefineOptions(mu_performance=False, occupants=subset, max_iter=max_iter,
+                         u_bound=u_bound)
+
+
+def _refine(job):
+    """One design: ``job = (kind, where, start path, max_iter, rounds, n_search,
+    u_bound)``; returns ``(kind, where, K as dict, figures)`` (picklable)."""
+    from lmi_suspension.io import controller_to_dict
+    from lmi_suspension.seat.multimodel import refine_for_occupants
+    from lmi_suspension.seat.occupant_subset import OccupantSubset
+    from lmi_suspension.seat.occupants import OccupantSet
+    from lmi_suspension.seat.refine import load_refined
+    from lmi_suspension.seat.scheduled import scheduling_subset
+
+    kind, where, start, max_iter, rounds, n_search, u_bound = job
+    K0 = load_refined(start)[0]
+    if kind == "bin":
+        subset = scheduling_subset(OccupantSet(), tuple(where), ERROR)
+    else:
+        m = float(where)
+        subset = OccupantSubset(nominal=replace(OccupantSet().nominal, m3=m), m3=(m, m))
+    t0 = time.perf_counter()
+    d = refine_for_occupants(K0, subset, _options(subset, max_iter, u_bound),
+                             rng=np.random.default_rng(DESIGN_SEED), rounds=rounds,
+                             n_search=n_search)
+    seconds = time.perf_counter() - t0
+    r = d.rounds[-1]
+    fig = {"seconds": seconds, "met": bool(d.design.met), "rounds": len(d.rounds),
+           "peak_over_limit_at_design_seats": float(np.max(d.design.peak)),
+           "u_at_design_seats": float(np.max(d.design.u_peak)),
+           "search_worst_ratio": float(r.worst_found),
+           "searched": {w.figure: float(w.value) for w in r.worst_seats},
+           "true_m3": list(subset.m3), "states": int(d.K.nstates)}
+    print(f"  {kind} {where}: {seconds:.0f} s, {fig}", flush=True)
+    return kind, where, controller_to_dict(d.K, inputs=["x1", "x3"], outputs=["u"]), fig
+
+
+def design(jobs: int, *, max_iter: int, rounds: int, n_search: int, u_bound: float,
+           edges=EDGES, masses=REF_MASSES, bins=True, refs=True, start=None):
+    """Design the bins and the references (``jobs`` processes); returns ``{(kind,
+    where): (K, figures)}``."""
+    from lmi_suspension.io import controller_from_dict
+
+    start = str(DATA / "mu_refined.json") if start is None else str(start)
+    work = []
+    if bins:
+        work += [("bin", (a, b), start, max_iter, rounds, n_search, u_bound)
+                 for a, b in zip(edges[:-1], edges[1:])]
+    if refs:
+        work += [("ref", m, start, max_iter, rounds, n_search, u_bound) for m in masses]
+    if jobs > 1:
+        with ProcessPoolExecutor(jobs) as pool:
+            out = list(pool.map(_refine, work))
+    else:
+        out = [_refine(w) for w in work]
+    return {(k, tuple(w) if k == "bin" else w): (controller_from_dict(K), f)
+            for k, w, K, f in out}
+
+
+def save_tables(designs, out: Path, budget: dict, command: str):
+    """Write ``mu_scheduled.json`` (bins) and ``mu_at_mass.json`` (references) from the
+    designs that are there."""
+    from lmi_suspension.io import save_scheduled_controller
+    from lmi_suspension.lti.gridded import GriddedController
+
+    common = {"error_kg": ERROR, "budget": budget, "command": command,
+              "start": "seat/data/mu_refined.json", "design_seed": DESIGN_SEED}
+    binned = sorted((w, v) for (k, w), v in designs.items() if k == "bin")
+    if binned:
+        edges = [binned[0][0][0]] + [w[1] for w, _ in binned]
+        Ks = GriddedController.from_controllers(
+            {"m3": edges}, [K for _, (K, _) in binned], inputs=["x1", "x3"], outputs=["u"],
+            interpolation="bins")
+        save_scheduled_controller(out / "mu_scheduled.json", Ks, metadata={
+            **common, "made": "benchmarks/scheduled_tuned.py: per bin [a, b] of the "
+            "estimated m3, refine_for_occupants over scheduling_subset(OccupantSet(), "
+            "(a, b), error) (true m3 in [a - error, b + error], all else the set's)",
+            "design_seconds": sum(f["seconds"] for _, (_, f) in binned),
+            "bins": [{"estimates": list(w), **f} for w, (_, f) in binned]})
+    refs = sorted((w, v) for (k, w), v in designs.items() if k == "ref")
+    if refs:
+        Kr = GriddedController.from_controllers(
+            {"m3": [w for w, _ in refs]}, [K for _, (K, _) in refs], inputs=["x1", "x3"],
+            outputs=["u"])
+        save_scheduled_controller(out / "mu_at_mass.json", Kr, metadata={
+            **common, "made": "benchmarks/scheduled_tuned.py: at each node mass m, "
+            "refine_for_occupants over OccupantSubset(m3=(m, m)) (everything but the "
+            "mass as the set): the controller tuned for exactly that mass.  Only the "
+            "nodes are designs; between them the interpolation is not one",
+            "design_seconds": sum(f["seconds"] for _, (_, f) in refs),
+            "nodes": [{"m3": w, **f} for w, (_, f) in refs]})
+
+
+# ------------------------------------------------------------------------- comparison
+
+def _constant(K):
+    """A fixed controller as a one-bin table over the set's masses (certify_scheduled
+    then gives certify_occupants' figures)."""
+    from lmi_suspension.lti.gridded import GriddedController
+
+    K = control.ss(K.A, K.B, K.C, K.D, inputs=["x1", "x3"], outputs=["u"])
+    return GriddedController.from_controllers({"m3": [30.0, 70.0]}, [K],
+                                              interpolation="bins")
+
+
+def _seat_ratio(K, p, limit, delays):
+    from lmi_suspension.seat.loop import BumpResponse
+    from lmi_suspension.seat.simulate import closed_loop_stable
+
+    if not all(closed_loop_stable(K, d, p) for d in delays):
+        return math.inf
+    return float(np.max(BumpResponse(delays=delays, params=p).peaks(K)[0])) / limit
+
+
+def compare(rows, *, n_stability, n_performance, mu, search_n, ref_file, omega=None):
+    """Print the comparison table and the ratio at the reference masses."""
+    from lmi_suspension.io import load_controller
+    from lmi_suspension.seat.limit import bump_limit
+    from lmi_suspension.seat.loop import _LIMIT_DT, REFINE_DELAYS
+    from lmi_suspension.seat.occupants import OccupantSet, occupant_samples
+    from lmi_suspension.seat.roads import bump
+    from lmi_suspension.seat.scheduled import certify_scheduled
+
+    t0 = time.perf_counter()
+    occ = OccupantSet()
+    samples = occupant_samples(occ, rng=np.random.default_rng(SAMPLE_SEED),
+                               n_stability=n_stability, n_performance=n_performance)
+    print(f"samples: {n_stability} stability, {n_performance} performance (seed "
+          f"{SAMPLE_SEED}), {time.perf_counter() - t0:.0f} s; nominal limit "
+          f"{samples.nominal_limit:.4f} m/s²\n", flush=True)
+    Kref, _ = load_controller(ref_file)
+    seats = {m: replace(occ.nominal, m3=m) for m in Kref.axes[0].tolist()}
+    limits = {m: float(bump_limit(bump(), p, dt=_LIMIT_DT).certified_peak)
+              for m, p in seats.items()}
+    ref_ratio = {m: _seat_ratio(Kref.at(m3=m), seats[m], limits[m], REFINE_DELAYS)
+                 for m in seats}
+    lines = ["| controller | nominal / limit | worst / own limit | max \\|u\\| samples / "
+             "searched | max \\|x1\\| samples / searched | unstable | RS mixed µ per value "
+             "| fastest pole | design time | certify time |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    mass_lines = ["| controller | " + " | ".join(f"m3 = {m:g} kg" for m in seats)
+                  + " |", "|---|" + "---|" * len(seats)]
+    mass_lines.append("| tuned for exactly that mass (`mu_at_mass.json`) | "
+                      + " | ".join(f"{ref_ratio[m]:.3f}" for m in seats) + " |")
+    for label, Ks, grid, seconds in rows:
+        t = time.perf_counter()
+        c = certify_scheduled(Ks, samples, rng=np.random.default_rng(ESTIMATE_SEED),
+                              error=ERROR, grid=grid, mu=mu, search=search_n > 0,
+                              search_n=max(search_n, 1), omega=omega)
+        mus = ", ".join(f"{v.rs_mu:.3f}" for v in c.values) if mu else "–"
+        poles = max(float(np.max(np.abs(np.linalg.eigvals(K.A)), initial=0.0))
+                    for K in getattr(Ks, "controllers", ()) or
+                    [Ks.at(m3=m) for m in np.linspace(30.0, 70.0, 17)])
+        sec = "–" if seconds is None or not math.isfinite(seconds) else f"{seconds:.0f} s"
+        lines.append(f"| {label} | {c.nominal_ratio:.3f} | {c.worst_ratio:.3f} | "
+                     f"{c.u_max:.0f} / {c.u_searched:.0f} N | {c.x1_max:.4f} / "
+                     f"{c.x1_searched:.4f} m | {c.unstable} of {c.n_stability} | {mus} | "
+                     f"{poles:.0f} rad/s | {sec} | {time.perf_counter() - t:.0f} s |")
+        print(lines[-1], flush=True)
+        cells = []
+        for m, p in seats.items():
+            lo, hi = Ks.bounds[0]
+            r = max(_seat_ratio(Ks.at(m3=float(np.clip(m + e, lo, hi))), p, limits[m],
+                                REFINE_DELAYS) for e in (0.0, -ERROR, ERROR))
+            cells.append(f"{r:.3f} ({r / ref_ratio[m]:.2f}×)")
+        mass_lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    print("\n" + "\n".join(lines))
+    print("\nPeak ratio at the seat of each mass (other parameters nominal, worst over "
+          "0-25 ms; scheduled controllers at the worst of estimate = true, ±5 kg); in "
+          "brackets over the reference tuned for that mass:\n")
+    print("\n".join(mass_lines))
+    print(f"\ncomparison: {time.perf_counter() - t0:.0f} s")
+
+
+def main(argv=None):
+    from lmi_suspension.io import load_controller
+
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--quick", action="store_true",
+                    help="8 performance and 50 stability samples, no µ, small search "
+                         "(with --design: 30 iterations, 5 search samples)")
+    ap.add_argument("--design", action="store_true", help="design the table anew")
+    ap.add_argument("--bins-only", action="store_true")
+    ap.add_argument("--refs-only", action="store_true")
+    ap.add_argument("--no-compare", action="store_true")
+    ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--out", default=str(DATA))
+    ap.add_argument("--u-bound", type=float, default=U_BOUND)
+    ap.add_argument("--rounds", type=int, default=ROUNDS)
+    args = ap.parse_args(argv)
+    out = Path(args.out)
+    budget = ({"max_iter": 30, "rounds": 1, "n_search": 5} if args.quick else
+              {"max_iter": MAX_ITER, "rounds": args.rounds, "n_search": N_SEARCH})
+    if args.design:
+        designs = design(args.jobs, **budget, u_bound=args.u_bound,
+                         bins=not args.refs_only, refs=not args.bins_only)
+        out.mkdir(parents=True, exist_ok=True)
+        save_tables(designs, out, {**budget, "u_bound": args.u_bound},
+                    "python benchmarks/scheduled_tuned.py " + " ".join(argv or []))
+    if args.no_compare:
+        return
+    Ks, meta = load_controller(out / "mu_scheduled.json")
+    Klpv, mlpv = load_controller(DATA / "lpv_scheduled.json")
+    Kocc, mocc = load_controller(DATA / "mu_occupants.json")
+    Kref, mref = load_controller(DATA / "mu_refined.json")
+    Kat, mat = load_controller(out / "mu_at_mass.json")
+    bins = [b[0] for b in Ks.bins]
+    rows = [("tuned, scheduled (`mu_scheduled.json`, bins of m̂ " + ", ".join(
+                f"{a:g}-{b:g}" for a, b in bins) + " kg)", Ks, None,
+             meta.get("design_seconds")),
+            ("convex, scheduled (`lpv_scheduled.json`)", Klpv,
+             [(a + b) / 2 for a, b in bins], mlpv.get("design_seconds")),
+            ("robust (`mu_occupants.json`)", _constant(Kocc), None,
+             mocc.get("design_seconds")),
+            ("single seat (`mu_refined.json`)", _constant(Kref), None,
+             mref.get("design_seconds"))]
+    if args.quick:
+        compare(rows, n_stability=50, n_performance=8, mu=False, search_n=0,
+                ref_file=out / "mu_at_mass.json")
+    else:
+        compare(rows, n_stability=400, n_performance=40, mu=True, search_n=20,
+                ref_file=out / "mu_at_mass.json")
+
+
+if __name__ == "__main__":
+    main()
