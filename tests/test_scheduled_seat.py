@@ -59,6 +59,9 @@ def test_subset_structure_and_corners():
     assert len(s.corners(("m3", "k1"))) == 2          # m3 has one end
     assert OccupantSubset(m3=(50.0, 50.0)).fixed == ("m3",)
     assert OccupantSubset(m3=(50.0, 50.0)).nominal.m3 == 50.0
+    # a mass fixed by a range of zero width: no mass scalar in µ (the µ model refuses a
+    # range of zero width; this failed before 2026-12-02)
+    assert OccupantSubset(m3=(50.0, 50.0)).mu_design().m3_range is None
     with pytest.raises(ParameterError, match="unknown"):
         OccupantSubset(fixed=("k4",))
     with pytest.raises(ParameterError, match="twice"):

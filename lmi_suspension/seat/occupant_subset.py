@@ -109,7 +109,11 @@ class OccupantSubset(OccupantSet):
     def mu_design(self, design=None):
         """The whole set's structure (:meth:`OccupantSet.mu_design`) without the real
         scalars of the fixed parameters."""
-        opts = super().mu_design(design)
+        # a mass range of zero width is no range for the µ model (it refuses one); the
+        # mass is fixed then, and its scalar left out below in any case
+        lo, hi = self.m3
+        base = self if hi > lo else replace(self, m3=(lo, lo + 1.0))
+        opts = super(OccupantSubset, base).mu_design(design)
         varying = set(self.varying())
         return replace(opts, m3_range=None if "m3" not in varying else opts.m3_range,
                        stiffness=tuple(n for n in opts.stiffness if n in varying),
