@@ -17,11 +17,14 @@ Run (from the repository root, about 15 minutes on one core of a 2-core Zen 1 EP
    1000); and static output feedback (``tunable_gain``, 4 starts) beside a reference: a
    brute-force grid where the gain has at most two entries, else 16 starts from another
    seed.  No published HIFOO / hinfstruct static-output-feedback figure for these plants
-   was found in the sources this project could search (searched 2026-12-02: Burke, Henrion,
-   Lewis & Overton 2006; Gumussoy & Overton 2008; Apkarian & Noll 2006; Gahinet & Apkarian
-   2011; Kočvara, Leibfritz, Stingl & Henrion 2005 (PENBMI); public repositories holding
-   COMPleib scripts: their tables are not in the stored text, the repositories print no
-   figures), so the reference is our own.
+   was found in the sources this project could search (2026-12-02: Burke, Henrion,
+   Lewis & Overton 2006, "HIFOO"; Gumussoy & Overton 2008, "Fixed-order H∞ controller
+   design via HIFOO" (names HE1 and REA2, at orders below the plant's); Apkarian & Noll
+   2006, "Nonsmooth H∞ synthesis"; Gahinet & Apkarian, "Frequency-domain tuning of
+   fixed-structure control systems" (a hinfstruct vs HIFOO benchmark); Kočvara,
+   Leibfritz, Stingl & Henrion, "A nonlinear SDP algorithm for static output feedback
+   problems in COMPleib": only their openings were readable, not their tables; public
+   repositories with COMPleib scripts print no figures), so the reference is our own.
 3. ``he1``: why HE1's full-order gap stays above 1 %.  (a) ``hinfsyn``'s own central
    controller at ``gamma_relax`` 0.05 %, 0.5 %, 1 %, 2 %, 5 % above the optimum, with its
    fastest pole and its largest entries (a pole above 2000 rad/s, input matrices of order
@@ -29,11 +32,15 @@ Run (from the repository root, about 15 minutes on one core of a 2-core Zen 1 EP
    controllers need: ``msyn`` (the LMI with every closed-loop pole in the disk
    ``|s| < R``, a common Lyapunov matrix: conservative) certifies +1.15 % with every
    closed-loop pole within 30 rad/s and +0.40 % within 100 rad/s (γ by ``hinfnorm`` of
-   ``lft(P, K)``, poles by ``eigvals``).  (c) The tuned full-order loop (2 starts of
-   1000 iterations): σ̄ of its closed loop is flat to 0.1 % from DC to a few rad/s, a
-   continuum of active frequencies, along which the one-peak subgradient of the BFGS
-   makes slow progress: the gap is the optimiser's, not a pole speed the block cannot
-   reach (see HISTORY, 2026-12-02, helper h60).
+   ``lft(P, K)``, poles by ``eigvals``); their own poles include an unstable one of
+   51-932 rad/s and their input gains are of order 1e4-1e6.  (c) The tuned full-order
+   loop (2 starts of 1000 iterations): σ̄ of its closed loop is flat to 0.1 % from DC to
+   about 5 rad/s (as are the LMI's near-optimal loops), and where a start stops, nothing
+   descends: BFGS continued, the same controller re-realized (modal, or a dense ``A``),
+   and a cutting-plane step over 82 frequencies of the plateau all end within 4e-5
+   (relative) of it.  The starts end at different local minima (2 × 1000 iterations:
+   +7.87 %; 2 × 3000: +7.37 % and +2.35 %), so the gap is a nonconvex landscape's, reached by the start and
+   the path (see HISTORY, 2026-12-02, helper h60), not a pole speed the block cannot reach.
 """
 import sys
 import time
