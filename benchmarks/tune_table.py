@@ -39,7 +39,7 @@ Run (from the repository root, about 15 minutes on one core of a 2-core Zen 1 EP
    descends: BFGS continued, the same controller re-realized (modal, or a dense ``A``),
    and a cutting-plane step over 82 frequencies of the plateau all end within 4e-5
    (relative) of it.  The starts end at different local minima (2 × 1000 iterations:
-   +7.87 %; 2 × 3000: +7.37 % and +2.35 %), so the gap is a nonconvex landscape's, reached by the start and
+   +7.87 %; 2 × 3000: +7.37 % and +2.35 %; 12 × 3000: the best +2.33 %), so the gap is a nonconvex landscape's, reached by the start and
    the path (see HISTORY, 2026-12-02, helper h60), not a pole speed the block cannot reach.
 """
 import sys
