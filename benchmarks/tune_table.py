@@ -175,11 +175,12 @@ def table_sof():
               f"| {dr:.0f} | {100 * (res.gamma / ref - 1):+.3f} % |", flush=True)
 
 
-def _flat_band(CL, level, w=np.logspace(-3, 4, 2801)):
+def _flat_band(CL, level):
     """The frequencies (rad/s) where σ̄ of ``CL`` is within ``level`` (relative) of its
-    largest value on the grid ``w`` (with DC): their lowest and highest."""
+    largest value on 2801 frequencies from 1e-3 to 1e4 rad/s and DC: their lowest and
+    highest."""
     A, B, C, D = (np.asarray(M, dtype=float) for M in (CL.A, CL.B, CL.C, CL.D))
-    w = np.r_[0.0, w]
+    w = np.r_[0.0, np.logspace(-3, 4, 2801)]
     eye = np.eye(A.shape[0])
     sig = np.array([np.linalg.svd(C @ np.linalg.solve(1j * x * eye - A, B) + D,
                                   compute_uv=False)[0] for x in w])
