@@ -572,8 +572,11 @@ def _final_bounds(CL, struct: BlockStructure, omega: np.ndarray, rng):
     scalings are certified by :func:`mussv` as the LMI's are.
     """
     from .bounds import MussvOptions, _ab13md_blocks, mussv
+    from .steps.dgstep import lower_where_it_counts, mixed_bounds
 
     M = freqresp(CL, omega)
+    if lower_where_it_counts(struct):  # real blocks: AB13MD's upper bound everywhere
+        return mixed_bounds(M, struct, omega, rng)
     mu = mussv(M, struct, omega=omega, rng=rng,
                options=MussvOptions(fast_maxiter=_FINAL_FAST_MAXITER))
     if mu.method != "fast":         # the LMI's or AB13MD's: the D-G bound already
