@@ -16,7 +16,7 @@ import numpy as np
 from ...lti.norms import freqresp
 from . import DKSetup, LoopAnalysis
 
-__all__ = ["MussvStep"]
+__all__ = ["MussvStep", "mixed_bounds", "lower_where_it_counts"]
 
 
 #: the mixed-µ lower bound of :func:`mixed_bounds` is computed at this many frequencies
