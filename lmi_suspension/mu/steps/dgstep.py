@@ -3,7 +3,9 @@
 :class:`MussvStep` runs :func:`~lmi_suspension.mu.mussv` with the run's D/G-step
 structure (``DKSetup.dk_struct``): D scalings for complex blocks, D and G scalings where
 real blocks stay real (D-G-K).  With constraints it also takes µ at the loop's lightly
-damped poles, whose sharp peaks a design grid steps over.
+damped poles, whose sharp peaks a design grid steps over.  With real blocks (an AB13MD
+structure) the µ lower bound is taken at the highest upper bounds only
+(:func:`mixed_bounds`, also the dense certificate's).
 """
 
 from __future__ import annotations
