@@ -544,3 +544,59 @@ def test_two_mass_mixed_musyn_is_no_worse_than_its_complexified_controller():
     theirs = mussv(freqresp(_mu_part(lft(P, res.complex_run.K), struct), dense), struct,
                    omega=dense, method="lmi")
     assert res.mu_peak <= float(np.max(theirs.upper)) * (1 + 1e-3)
+
+
+def test_mixed_bounds_keep_mussvs_upper_bound_and_its_lower_peak(loop):
+    """``mixed_bounds`` (the D/G-step's and the dense certificate's µ with real blocks)
+    computes the lower bound at the highest upper bounds only: its upper bounds are
+    ``mussv``'s own at every frequency, its lower bound is ``mussv``'s where computed
+    and 0 elsewhere, and its peak is the peak of ``mussv``'s lower bound computed here at
+    every frequency (power iteration: 1e-4)."""
+    from lmi_suspension.mu.steps import dgstep
+
+    _, _, struct, w, M = loop
+    w, M = w[::2], M[:, :, ::2]  # 13 points: the reference's lower bound is the cost
+    assert dgstep.lower_where_it_counts(struct)
+    assert not dgstep.lower_where_it_counts(BlockStructure.coerce([[1, 1], [2, 2]]))
+    assert not dgstep.lower_where_it_counts(BlockStructure.coerce([[-2, 0], [2, 2]]))
+    got = dgstep.mixed_bounds(M, struct, w, np.random.default_rng(0))
+    full = mussv(M, struct, omega=w, rng=np.random.default_rng(0))
+    assert full.method == got.method == "ab13md"
+    np.testing.assert_allclose(got.upper, full.upper, rtol=1e-12)
+    lower = np.asarray(got.lower)
+    assert np.all(lower <= np.asarray(got.upper))
+    assert 1 <= np.count_nonzero(lower) <= dgstep._LOWER_POINTS + dgstep._LOWER_PEAKS
+    assert np.max(lower) == pytest.approx(float(np.max(full.lower)), rel=1e-4)
+    assert np.argmax(lower) == np.argmax(full.upper) or np.max(lower) >= np.max(full.lower)
+
+
+def test_every_dgk_k_step_sees_a_scaled_plant_within_the_fit_caps(monkeypatch):
+    """The order of the plant each K-step sees is bounded by the caps of the fits
+    (issue 64): the plant's states, each D fit's order (``max_dfit_order``) on the
+    ``z`` and ``w`` channels of its block (the last block's D is 1), and three states per
+    G basis pole (``max_gfit_poles``) and real channel (gfit's docstring).  Recorded at
+    every K-step of a short run of both phases; the returned loop is checked apart
+    (poles, bounds in order)."""
+    from lmi_suspension.mu.steps import DKSteps
+    from lmi_suspension.mu.steps.kstep import HinfKStep
+
+    _coarse_dense_grid(monkeypatch)
+    ex = stiffness_oscillator()
+    struct = BlockStructure.coerce(BLK)
+    seen = []
+
+    class Recorded(HinfKStep):
+        def __call__(self, PD, *, iteration, gamma_prev):
+            seen.append((self.setup.mixed, iteration, PD.nstates))
+            return super().__call__(PD, iteration=iteration, gamma_prev=gamma_prev)
+
+    opts = MusynOptions(max_iter=3, patience=3, max_dfit_order=2,
+                        **dict(_QUICK, max_gfit_poles=2))
+    res = musyn(ex.P, 1, 1, BLK, omega=_QUICK_W, options=opts, steps=DKSteps(kstep=Recorded))
+    d_states = sum(2 * (b.rows + b.cols) for b in struct.blocks[:-1])  # order 2 per channel
+    g_states = 3 * 2 * sum(b.rows for b in struct.blocks if b.is_real)
+    later = [(mixed, n) for mixed, it, n in seen if it > 1]
+    assert any(mixed for mixed, _ in later) and any(not mixed for mixed, _ in later)
+    for mixed, n in later:
+        assert n <= ex.P.nstates + d_states + (g_states if mixed else 0)
+    assert np.all(res.CL.poles().real < 0) and res.mu_lower_peak <= res.mu_peak
