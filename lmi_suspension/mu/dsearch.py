@@ -68,7 +68,7 @@ _TIE_OUTLIERS = 0.05
 #: all digits, and 20 % faster (distillation, measured 2026-11-26).  The level to 4e-7
 #: with the difference quotients' brackets ±4e-4 (below): 11 halvings per quotient instead
 #: of 15, two fewer per trial point.  Default ``musyn`` on dkpy's and the
-#: project's realization of distillation, native (Haswell) and Sandybridge kernels: the
+#: project's realization of distillation, native (SkylakeX) and Sandybridge kernels: the
 #: search's syntheses 2118 -> 1786, 2257 -> 1958, 2061 -> 1752, 2237 -> 2372 (a longer
 #: search), µ 0.958778 -> 0.958751, 0.959508 -> 0.959402, 0.959361 -> 0.958973,
 #: 0.959548 -> 0.958286 (measured 2026-12-02)
