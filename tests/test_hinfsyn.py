@@ -1014,3 +1014,48 @@ def test_a_riccati_controller_that_does_not_beat_the_optimum_says_nothing(monkey
     res = hinfsyn(P, 4, 4)
     assert res.gamma_lower == ref.gamma_lower
     assert not any("SLICOT's Riccati controller" in w for w in res.warnings)
+
+
+@pytest.mark.parametrize("case", ["scalar", "d22"])
+def test_riccati_level_test_is_sb10ads_verdict(case):
+    """The test ``riccati_level`` bisects (``sb10fd`` once and the loop's poles, formed
+    here) gives ``sb10ad``'s (job 4) verdict, which runs the same formulas and checks
+    the same loop itself: at levels across the boundary of two plants, the scalar one
+    of Doyle et al. (γ_opt = 1 + sqrt(3), ``scalar_gamma_opt``) and a random one with
+    D22 != 0 (the loop's formula with the feedthrough).  The loop matrix is compared,
+    by its eigenvalues, with ``lft`` of the controller ``sb10ad`` returns."""
+    import sys
+
+    from slycot import sb10ad
+
+    module = sys.modules["lmi_suspension.synthesis.hinfsyn"]
+    if case == "scalar":
+        P, ref = scalar_plant(1.0), scalar_gamma_opt(1.0)
+    else:
+        P = random_plant(6, 2, 2, 2, 2, rng=np.random.default_rng(64), d22=True)
+        ref = module.riccati_level(P, 2, 2, HinfsynOptions(riccati_rtol=1e-6))
+    A, B, C, D = (np.asarray(M, dtype=float) for M in (P.sys.A, P.sys.B, P.sys.C, P.sys.D))
+    test = module._sb10ad_stabilises(P)
+    verdicts = []
+    # (not at the boundary itself: at γ_opt to the last digit the scalar plant's
+    # controller has a pole at -1.2e16, and either loop's poles are rounding)
+    for g in ref * np.concatenate([np.geomspace(0.5, 2.0, 8), 1 + np.array([-1e-9, 1e-9])]):
+        try:
+            out = sb10ad(A.shape[0], B.shape[1], C.shape[0], P.nu, P.ny, float(g), A, B,
+                         C, D, job=4)
+            theirs = bool(np.all(np.real(np.linalg.eigvals(out[5])) < 0))
+        except Exception:  # slycot's own classes: no controller at this level
+            out, theirs = None, False
+        assert test(g) == theirs
+        verdicts.append(theirs)
+        if out is not None:
+            K = control.ss(*out[1:5])
+            mine = module._loop_matrix(A, B, C, D, P.nu, P.ny, *out[1:5])
+            want = np.sort_complex(np.linalg.eigvals(np.asarray(lft(P, K).A)))
+            np.testing.assert_allclose(np.sort_complex(np.linalg.eigvals(mine)), want,
+                                       rtol=1e-8, atol=1e-8 * np.max(np.abs(want)))
+    # both sides of the boundary were visited
+    assert any(verdicts) and not all(verdicts)
+    if case == "scalar":  # the level bisected is DGKF's γ_opt
+        level = module.riccati_level(P, 1, 1, HinfsynOptions(riccati_rtol=1e-8))
+        assert level == pytest.approx(ref, rel=1e-6)

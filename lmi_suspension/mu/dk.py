@@ -226,9 +226,9 @@ class MusynOptions:
         by 0.01 % over the points of three gradients (:mod:`.dsearch`; on distillation
         from dkpy's realization: 157 points, level 0.959188, where the 200 points of
         the bound reached 0.958984; measured 2026-12-02).  A level
-        costs 15 (difference quotient) to 20 (trial step) syntheses of 3-4 ms on
+        costs 11 (difference quotient) to 18 (trial step) syntheses of 2.5 ms on
         distillation's 22-state scaled plants, a trial point found above the current
-        level one (measured 2026-11-28).  Repeated-scalar blocks are searched with
+        level one (measured 2026-11-28 and 2026-12-02).  Repeated-scalar blocks are searched with
         scalings ``d(s) I``, a restriction of their D matrices (still a valid bound).
     complexify : bool
         Treat real scalar blocks (``[-r, 0]``) as complex in the loop (complex D-K, the

@@ -198,16 +198,23 @@ class _Basis:
         ``pairs`` of ``(P_k, Q_k, c_k)``.  With ``E_i`` written as a sum of ``e_p e_qᵀ``,
         a term is ``P[q, r] Q[s, p]``: the terms of each row ``i`` are summed over its
         ``(p, q)`` and over the pairs first, as outer products of rows of ``P_k`` and
-        ``Q_kᵀ``, and the columns ``(r, s)`` of each ``E_j`` gathered once (2.5 ms for
-        three pairs at 30 states, against 5.2 ms pair by pair with gathers of every
-        term; measured 2026-11-29)."""
+        ``Q_kᵀ`` -- one small matrix product per row, ``(n, 2K) @ (2K, n)`` for ``K``
+        pairs, batched -- and the columns ``(r, s)`` of each ``E_j`` gathered once.
+        At 60 states with five pairs the batched products took 0.20 s against 0.53 s
+        for the outer products added term by term (each a temporary of ``size * n * n``),
+        equal to 3e-16; at 30 states with three pairs the term-by-term sums took 2.5 ms,
+        against 5.2 ms pair by pair with gathers of every term (measured 2026-12-02 and
+        2026-11-29)."""
         a, b, n = self.a, self.b, self.n
-        rows = np.zeros((self.size, n, n))  # rows[i, r, s]: the terms of E_i, any E_j
-        for P, Q, c in pairs:
+        left = np.empty((self.size, n, 2 * len(pairs)))
+        right = np.empty((self.size, 2 * len(pairs), n))
+        for k, (P, Q, c) in enumerate(pairs):
             Qt = Q.T
-            rows += (c * P[b])[:, :, None] * Qt[a][:, None, :]
-            rows += (c * P[a])[:, :, None] * Qt[b][:, None, :]
-        rows = rows.reshape(self.size, n * n)
+            left[:, :, 2 * k] = c * P[b]
+            left[:, :, 2 * k + 1] = c * P[a]
+            right[:, 2 * k, :] = Qt[a]
+            right[:, 2 * k + 1, :] = Qt[b]
+        rows = np.matmul(left, right).reshape(self.size, n * n)  # rows[i, r * n + s]
         out += (rows[:, self._ab] + rows[:, self._ba]) * self._ww
 
 
