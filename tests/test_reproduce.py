@@ -18,6 +18,7 @@ from matplotlib.image import imread
 
 from lmi_suspension.errors import AssumptionError, ParameterError
 from lmi_suspension.io import load_controller
+from lmi_suspension.lti.gridded import GriddedController
 from lmi_suspension.mu.dk import MusynIteration
 from lmi_suspension.seat.augmented import CONSTRAINED_DESIGN
 from lmi_suspension.seat.mucheck import ConstrainedCheck
@@ -42,7 +43,7 @@ EXPECTED_PNGS = {
     "fig11_bump_u_applied.png", "fig12_noise_z3dd.png", "fig13_noise_x1.png",
     "fig14_noise_u_applied.png", "fig15_mu_bounds.png", "peak_vs_delay.png", "iso_C_z3dd.png",
     "force_commanded_vs_applied.png", "mu_bounds_constrained.png", "mu_bounds_refined.png",
-    "tradeoff_refined.png", "occupant_map.png", "worst_case.png",
+    "tradeoff_refined.png", "occupant_map.png", "worst_case.png", "ratio_over_mass.png",
 }
 #: the stand-in of the shipped constrained controller: a weaker low-passed stiffness
 K_CONSTRAINED = control.ss([[-150.0]], [[150.0, 0.0]], [[4000.0]], [[0.0, 500.0]])
@@ -57,13 +58,23 @@ K_REFINED = control.ss([[-250.0]], [[250.0, 0.0]], [[6000.0]], [[0.0, 800.0]])
 #: holds 1500 N, see test_multimodel)
 V2 = Path(__file__).parent / "data" / "multiseat_v2.json"
 K_OCCUPANTS = load_controller(V2)[0]
+#: the stand-in of the shipped scheduled controller: the one for every occupant at 30 kg
+#: and its output scaled by 1.05 at 70 kg, so that a cell's controller depends on its mass
+K_SCHEDULED = GriddedController.from_controllers(
+    {"m3": [30.0, 70.0]}, [K_OCCUPANTS, control.ss(K_OCCUPANTS.A, K_OCCUPANTS.B,
+                                                   1.05 * K_OCCUPANTS.C, 1.05 * K_OCCUPANTS.D)],
+    inputs=["x1", "x3"], outputs=["u"])
+#: the stand-in of the controllers tuned for exactly one mass: the refined one at 43.3 kg
+#: and the constrained one at 60 kg
+K_AT_MASS = GriddedController.from_controllers({"m3": [43.3, 60.0]}, [K_REFINED, K_CONSTRAINED],
+                                              inputs=["x1", "x3"], outputs=["u"])
 
 
 def _same(K1, K2) -> bool:
     return all(np.array_equal(getattr(K1, m), getattr(K2, m)) for m in "ABCD")
 
 
-def _stand_in(fail_riccati=False, fail_occupants=False):
+def _stand_in(fail_riccati=False, fail_occupants=False, fail_scheduled=False):
     # Low-passed extra stiffness on x1 and a little on x3: a stable loop with a finite
     # delay margin, unlike any µ design, so wrong wiring shows up in the numbers.
     K_mu = control.ss([[-200.0]], [[200.0, 0.0]], [[15000.0]], [[0.0, 2000.0]])
@@ -116,6 +127,14 @@ def _stand_in(fail_riccati=False, fail_occupants=False):
                                 figures={"u_bound": u_bound}, seconds=0.0,
                                 description=f"stand-in {route}")
 
+    def load_scheduled():
+        if fail_scheduled:
+            raise OSError("stand-in: mu_scheduled.json missing")
+        return K_SCHEDULED, {"description": "stand-in scheduled", "stand_in": True}
+
+    def load_at_mass():
+        return K_AT_MASS, {"description": "stand-in at mass"}
+
     def load_refined_tradeoff():
         calls.append("tradeoff")
         points = tuple(SimpleNamespace(u_bound=b, mu_peak=0.98, bump_peak=(p, p + 0.3),
@@ -139,6 +158,7 @@ def _stand_in(fail_riccati=False, fail_occupants=False):
                           design_nominal_hinf=design_nominal_hinf,
                           analyse_uncertainty=analyse_uncertainty,
                           load_seat_design=load_seat_design,
+                          load_scheduled=load_scheduled, load_at_mass=load_at_mass,
                           load_refined_tradeoff=load_refined_tradeoff,
                           certify_seat=certify_seat,
                           DEFAULT_DESIGN=SeatDesignOptions(), DEFAULT_MUSYN=None)
