@@ -1084,8 +1084,12 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     timings["total"] = total
     facts = _design_facts(summaries, params.u_max)
     if exported != EXPORTED:
+        # the designs before it in the order of export, each with why it is not there
+        skipped = [n for n in (EXPORTED, ROBUST) if n != exported][
+            :(EXPORTED, ROBUST, "mu").index(exported)]
         facts += (f"controller.json holds the {_LONG_NAMES[exported]} design: "
-                  f"{_LONG_NAMES[EXPORTED]} failed ({errors.get(EXPORTED, 'not loaded')})",)
+                  + "; ".join(f"{_LONG_NAMES[n]} failed ({errors.get(n, 'not loaded')})"
+                              for n in skipped),)
     if meta_export.get("stand_in"):
         facts += (f"controller.json is a stand-in: {meta_export.get('description', '')}",)
     if scheduled is not None and not scheduled[3].passed:
