@@ -39,7 +39,6 @@ from lmi_suspension.seat.occupants import occupant_samples
 from lmi_suspension.seat.schedule_use import (
     DEFAULT_REQUIREMENTS,
     SHIPPED_SCHEDULED,
-    MassErrorRow,
     first_broken,
     inject_mass_error,
 )

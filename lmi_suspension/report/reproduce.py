@@ -569,7 +569,7 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     from ..errors import InputError
     from ..io import save_controller, save_controller_mat, save_scheduled_controller
     from ..seat.sampled import discretise_controller, fastest_pole, simulate_sampled
-    from ..seat.schedule_use import (controller_for_seat, is_scheduled, ratio_over_mass,
+    from ..seat.schedule_use import (controller_for_seat, is_scheduled,
                                      sampled_schedule_check, schedule_nodes)
     from ..seat import (
         SeatParameters,
@@ -1227,7 +1227,6 @@ def _ratio_over_mass(Ks, K_robust, api, cfg: _Settings, params, errors: dict) ->
         controllers[_PER_MASS] = at_mass
     except (LmiSuspensionError, OSError, ValueError) as exc:
         errors["mu_at_mass"] = f"{type(exc).__name__}: {exc}"
-    (lo, hi), = [b for n, b in zip(Ks.names, Ks.bounds) if n == "m3"] or [(0.0, math.inf)]
     # the per-mass controllers' own masses too: the scheduled one is compared there
     node_m3 = [] if at_mass is None else [p["m3"] for p in schedule_nodes(at_mass)]
     masses = sorted(set(cfg.ratio_m3) | set(node_m3))
