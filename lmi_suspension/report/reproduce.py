@@ -4,11 +4,14 @@
 7–15 of the paper plus the peak-versus-delay study), ``summary.json`` and ``controller.json``
 into one directory. :func:`comparison_table` formats the headline figures as text.
 
-``controller.json`` is the shipped controller for every occupant (30–70 kg, springs and
-dampers ±20 %, delay 0–25 ms; :data:`~lmi_suspension.seat.multimodel.SHIPPED_OCCUPANTS`),
-not this run's µ design: the µ design goes unstable once the seat spring is about 17 %
-soft (issue 38), and a user who takes the run's controller takes it to a seat that is not
-the nominal one.  The µ design is ``controllers/mu.json``.
+``controller.json`` is the shipped seat controller scheduled on what the seat measures
+(issue 62, :data:`~lmi_suspension.seat.schedule_use.SHIPPED_SCHEDULED`), with its
+schedule; where that cannot be loaded, the shipped controller for every occupant (30–70
+kg, springs and dampers ±20 %, delay 0–25 ms;
+:data:`~lmi_suspension.seat.multimodel.SHIPPED_OCCUPANTS`); never this run's µ design: the
+µ design goes unstable once the seat spring is about 17 % soft (issue 38), and a user who
+takes the run's controller takes it to a seat that is not the nominal one.  The µ design
+is ``controllers/mu.json``.
 
 Deviation from the paper, on purpose: the white-noise floor velocity has a two-sided PSD of
 ``1e-4`` (m/s)²/Hz in a 50 Hz band (about the level of an ISO 8608 class-C road at 30 km/h),
@@ -512,11 +515,17 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     Files written: ``fig07_bump.png`` … ``fig15_mu_bounds.png`` (the paper's figures),
     ``peak_vs_delay.png``, ``iso_C_z3dd.png``, ``summary.json`` (non-finite numbers are
     written as ``null``; a ``null`` delay margin means no loss of stability below 1 s) and
-    ``controller.json`` (the controller for every occupant, ``y = [x1, x3]`` in m to ``u``
-    in N; its µ with the paper's weights at the nominal seat recomputed here, its mixed µ
-    over the set quoted from its design; the µ design only where the shipped file cannot
-    be loaded, which the summary's facts then say) and ``controller.mat``;
-    ``occupant_map.png`` (its map, the set's box and the stability boundary drawn),
+    ``controller.json`` (the controller scheduled on the occupant's measured values, with
+    its schedule, ``y = [x1, x3]`` in m to ``u`` in N; its µ with the paper's weights at
+    the nominal seat and its 1 kHz loop at every scheduling value
+    (:func:`~lmi_suspension.seat.schedule_use.sampled_schedule_check`) recomputed here;
+    the controller for every occupant, then the µ design, where the shipped files cannot
+    be loaded, which the summary's facts then say) and ``controller.mat`` (a scheduled
+    one's node controllers as an array of models); ``occupant_map.png`` (its map beside
+    the robust controller's on one colour scale, the set's box and the stability
+    boundary drawn), ``ratio_over_mass.png`` (peak over each seat's own limit along the
+    mass: the schedule, the robust controller and the controllers tuned for exactly one
+    mass, :data:`~lmi_suspension.seat.schedule_use.SHIPPED_AT_MASS`, at their masses),
     ``occupant_map/`` (the map's sweep table), ``worst_case.png`` (the worst seat of the
     map in the set, on the bump: ``z̈3`` against that seat's own limit, force, stroke);
     ``controllers/<name>.json`` for every designed controller, each with its 1 kHz
