@@ -105,6 +105,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     from .errors import InputError, ParameterError
     from .io import load_controller
     from .seat import closed_loop_stable, simulate
+    from .seat.schedule_use import controller_for_seat, schedule_point
 
     path = Path(args.controller)
     if not path.is_file():
@@ -119,8 +120,16 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     except (KeyError, TypeError, IndexError) as exc:
         raise InputError(f"{path} is not a saved controller ({type(exc).__name__}: {exc})") \
             from exc
+    Ks = K
     road = _road(args.road, args.seed, args.duration)
+    seat, scheduled_on = _simulated_seat(args, K)
+    K = controller_for_seat(K, seat, scheduled_on)
+    if scheduled_on is not None:
+        scheduled_on = schedule_point(Ks, seat, scheduled_on)
     if args.discrete:
+        if scheduled_on is not None:
+            raise InputError(f"--discrete: {path} holds a scheduled controller, which has no "
+                             f"discrete realization in the file; run it continuous")
         import numpy as np
 
         from .io import load_discrete_controller
@@ -133,17 +142,17 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
             if len(noise) != 2:
                 raise ParameterError(f"--noise takes two standard deviations (m), x1,x3; "
                                      f"got {args.noise!r}")
-        res = simulate_sampled(Kd, road, delay=args.delay, noise=noise,
+        res = simulate_sampled(Kd, road, delay=args.delay, params=seat, noise=noise,
                                quantisation=args.quantisation,
                                rng=np.random.default_rng(args.seed))
         realization = f"discrete, {1 / Kd.dt:g} Hz, zero-order hold"
     else:
         if args.noise is not None or args.quantisation is not None:
             raise ParameterError("--noise and --quantisation apply to --discrete runs")
-        res = simulate(K, road, delay=args.delay)
+        res = simulate(K, road, delay=args.delay, params=seat)
         realization = "continuous"
     m = res.metrics()
-    linear = closed_loop_stable(K, args.delay)
+    linear = closed_loop_stable(K, args.delay, seat)
     if args.plot:
         from .report.figures import plot_responses
 
@@ -152,7 +161,8 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         fig.savefig(args.plot, dpi=110)
     if args.json:
         data = {"controller": str(path), "realization": realization,
-                "road": road.description, "delay": args.delay,
+                "road": road.description, "delay": args.delay, "m3": seat.m3, "k1": seat.k1,
+                "scheduled_on": scheduled_on,
                 "seed": args.seed, "stable_linear": linear, **dataclasses.asdict(m)}
         data = {k: (None if isinstance(v, float) and not math.isfinite(v) else v)
                 for k, v in data.items()}
@@ -161,6 +171,11 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     out = sys.stdout
     out.write(f"controller {path} ({K.nstates} states, {realization}), road: "
               f"{road.description}, delay {args.delay * 1e3:g} ms\n")
+    out.write(f"seat: m3 {seat.m3:g} kg, k1 {seat.k1:g} N/m"
+              + ("" if scheduled_on is None else "; scheduled on the estimate "
+                 + ", ".join(f"{n} = {v:g}" for n, v in scheduled_on.items())
+                 + " (true value plus the estimate error, held in the schedule's range)")
+              + "\n")
     rows = [("peak |z3''|", m.peak_z3dd, "m/s^2"), ("RMS z3''", m.rms_z3dd, "m/s^2"),
             ("Wk-weighted RMS z3''", m.weighted_rms_z3dd, "m/s^2"),
             ("VDV", m.vdv_z3dd, "m/s^1.75"), ("peak |x1|", m.peak_x1, "m"),
@@ -173,6 +188,40 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     out.write(f"  {'stable (simulation)':<22} {'yes' if m.stable else 'NO':>12}\n")
     out.write(f"  {'stable (Nyquist)':<22} {'yes' if linear else 'NO':>12}\n")
     return 0
+
+
+def _simulated_seat(args: argparse.Namespace, K) -> tuple:
+    """The seat ``simulate`` runs (Table 1 with ``--m3``, ``--k1``) and, for a scheduled
+    controller, the estimate errors it is scheduled with (None for one controller)."""
+    import dataclasses
+    import math
+
+    from .errors import ParameterError
+    from .seat import SeatParameters
+    from .seat.schedule_use import is_scheduled
+
+    seat = SeatParameters()
+    for name in ("m3", "k1"):
+        v = getattr(args, name)
+        if v is not None:
+            if not (math.isfinite(v) and v > 0):
+                raise ParameterError(f"--{name} must be a positive number, got {v}")
+            seat = dataclasses.replace(seat, **{name: float(v)})
+    errors = {n: getattr(args, f"{n}_error") for n in ("m3", "k1")
+              if getattr(args, f"{n}_error") is not None}
+    for n, e in errors.items():
+        if not math.isfinite(e):
+            raise ParameterError(f"--{n}-error must be a finite number, got {e}")
+    if not is_scheduled(K):
+        if errors:
+            raise ParameterError(f"--{next(iter(errors))}-error: the controller is not "
+                                 f"scheduled; it measures nothing")
+        return seat, None
+    unused = [n for n in errors if n not in K.names]
+    if unused:
+        raise ParameterError(f"--{unused[0]}-error: the schedule is on {', '.join(K.names)}, "
+                             f"not {unused[0]}")
+    return seat, errors
 
 
 def _write_certificate(c, out=None) -> None:
@@ -437,7 +486,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     from .sweep import SweepSpec, run_sweep
     from .sweep.spec import parse_range
 
-    axes = [("m3", args.m3), ("delay", args.delay)]
+    axes = [("m3", args.m3), ("delay", args.delay), ("m3_error", args.m3_error)]
     for item in args.param or ():
         name, sep, value = item.partition("=")
         if not sep or not name:
@@ -544,8 +593,20 @@ def build_parser() -> argparse.ArgumentParser:
     p_rep.set_defaults(func=_cmd_reproduce)
 
     p_sim = sub.add_parser("simulate", help="simulate a saved controller on a road")
-    p_sim.add_argument("--controller", required=True, help="controller JSON (save_controller)")
+    p_sim.add_argument("--controller", required=True,
+                       help="controller JSON (save_controller, or a scheduled controller's "
+                            "file: run at --m3/--k1 plus the estimate errors)")
     p_sim.add_argument("--delay", type=float, default=0.0, help="actuator delay in seconds")
+    p_sim.add_argument("--m3", type=float, default=None,
+                       help="the occupant's upper-body mass, kg (default Table 1, 43.3); a "
+                            "scheduled controller runs scheduled on it")
+    p_sim.add_argument("--m3-error", type=float, default=None,
+                       help="with a scheduled controller: the seat's mass estimate minus "
+                            "the true mass, kg (default 0)")
+    p_sim.add_argument("--k1", type=float, default=None,
+                       help="the seat spring, N/m (default Table 1)")
+    p_sim.add_argument("--k1-error", type=float, default=None,
+                       help="with a controller scheduled on k1: the estimate's error, N/m")
     p_sim.add_argument("--road", choices=_ROADS, default="bump",
                        help="bump (eq. 32), noise (white floor velocity) or iso-C "
                             "(ISO 8608 class C at 30 km/h)")
@@ -576,8 +637,12 @@ def build_parser() -> argparse.ArgumentParser:
                            "'design:ROUTE' for one designed per seat, see 'design')")
     p_sw.add_argument("--m3", default=None, help="upper-body mass, kg (e.g. 30:70:9)")
     p_sw.add_argument("--delay", default=None, help="actuator delay, s (e.g. 0:0.05:11)")
+    p_sw.add_argument("--m3-error", default=None,
+                      help="a scheduled controller's mass-estimate error, kg (e.g. -10:10:5; "
+                           "other estimates' errors as --param k1_error=...)")
     p_sw.add_argument("--param", action="append", default=None, metavar="NAME=RANGE",
-                      help="another axis: a seat parameter (k1, c2, ...) or the road's "
+                      help="another axis: a seat parameter (k1, c2, ...), a scheduled "
+                           "controller's estimate error (k1_error, ...) or the road's "
                            "(height, length, speed_kmh; psd)")
     p_sw.add_argument("--road", choices=("bump", "iso8608", "noise"), default="bump",
                       help="the road (default bump, eq. 32)")

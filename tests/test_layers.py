@@ -151,7 +151,7 @@ SEAT_FLOORS = (
     ("params", "model", "roads", "comfort", "weights", "simulate", "limit", "uncertainty",
      "augmented", "sampled"),
     ("loop", "goals", "mucheck", "occupants", "worstcase", "scheduled_lpv", "occupant_subset",
-     "scheduled"),
+     "scheduled", "schedule_use"),
     ("record",),
     ("design", "constrained", "bounded", "discrete_design", "refine", "multimodel"),
     ("routes",),

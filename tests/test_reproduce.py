@@ -18,6 +18,7 @@ from matplotlib.image import imread
 
 from lmi_suspension.errors import AssumptionError, ParameterError
 from lmi_suspension.io import load_controller
+from lmi_suspension.lti.gridded import GriddedController
 from lmi_suspension.mu.dk import MusynIteration
 from lmi_suspension.seat.augmented import CONSTRAINED_DESIGN
 from lmi_suspension.seat.mucheck import ConstrainedCheck
@@ -42,7 +43,7 @@ EXPECTED_PNGS = {
     "fig11_bump_u_applied.png", "fig12_noise_z3dd.png", "fig13_noise_x1.png",
     "fig14_noise_u_applied.png", "fig15_mu_bounds.png", "peak_vs_delay.png", "iso_C_z3dd.png",
     "force_commanded_vs_applied.png", "mu_bounds_constrained.png", "mu_bounds_refined.png",
-    "tradeoff_refined.png", "occupant_map.png", "worst_case.png",
+    "tradeoff_refined.png", "occupant_map.png", "worst_case.png", "ratio_over_mass.png",
 }
 #: the stand-in of the shipped constrained controller: a weaker low-passed stiffness
 K_CONSTRAINED = control.ss([[-150.0]], [[150.0, 0.0]], [[4000.0]], [[0.0, 500.0]])
@@ -57,13 +58,23 @@ K_REFINED = control.ss([[-250.0]], [[250.0, 0.0]], [[6000.0]], [[0.0, 800.0]])
 #: holds 1500 N, see test_multimodel)
 V2 = Path(__file__).parent / "data" / "multiseat_v2.json"
 K_OCCUPANTS = load_controller(V2)[0]
+#: the stand-in of the shipped scheduled controller: the one for every occupant at 30 kg
+#: and its output scaled by 1.05 at 70 kg, so that a cell's controller depends on its mass
+K_SCHEDULED = GriddedController.from_controllers(
+    {"m3": [30.0, 70.0]}, [K_OCCUPANTS, control.ss(K_OCCUPANTS.A, K_OCCUPANTS.B,
+                                                   1.05 * K_OCCUPANTS.C, 1.05 * K_OCCUPANTS.D)],
+    inputs=["x1", "x3"], outputs=["u"])
+#: the stand-in of the controllers tuned for exactly one mass: the refined one at 43.3 kg
+#: and the constrained one at 60 kg
+K_AT_MASS = GriddedController.from_controllers({"m3": [43.3, 60.0]}, [K_REFINED, K_CONSTRAINED],
+                                              inputs=["x1", "x3"], outputs=["u"])
 
 
 def _same(K1, K2) -> bool:
     return all(np.array_equal(getattr(K1, m), getattr(K2, m)) for m in "ABCD")
 
 
-def _stand_in(fail_riccati=False, fail_occupants=False):
+def _stand_in(fail_riccati=False, fail_occupants=False, fail_scheduled=False):
     # Low-passed extra stiffness on x1 and a little on x3: a stable loop with a finite
     # delay margin, unlike any µ design, so wrong wiring shows up in the numbers.
     K_mu = control.ss([[-200.0]], [[200.0, 0.0]], [[15000.0]], [[0.0, 2000.0]])
@@ -116,6 +127,14 @@ def _stand_in(fail_riccati=False, fail_occupants=False):
                                 figures={"u_bound": u_bound}, seconds=0.0,
                                 description=f"stand-in {route}")
 
+    def load_scheduled():
+        if fail_scheduled:
+            raise OSError("stand-in: mu_scheduled.json missing")
+        return K_SCHEDULED, {"description": "stand-in scheduled", "stand_in": True}
+
+    def load_at_mass():
+        return K_AT_MASS, {"description": "stand-in at mass"}
+
     def load_refined_tradeoff():
         calls.append("tradeoff")
         points = tuple(SimpleNamespace(u_bound=b, mu_peak=0.98, bump_peak=(p, p + 0.3),
@@ -139,6 +158,7 @@ def _stand_in(fail_riccati=False, fail_occupants=False):
                           design_nominal_hinf=design_nominal_hinf,
                           analyse_uncertainty=analyse_uncertainty,
                           load_seat_design=load_seat_design,
+                          load_scheduled=load_scheduled, load_at_mass=load_at_mass,
                           load_refined_tradeoff=load_refined_tradeoff,
                           certify_seat=certify_seat,
                           DEFAULT_DESIGN=SeatDesignOptions(), DEFAULT_MUSYN=None)
@@ -237,27 +257,81 @@ def test_summary_has_every_controller_and_delay(run):
             {r[n] for r in rows}
 
 
+def _scheduled_at(r) -> control.StateSpace:
+    """The stand-in schedule at a row's estimate (true mass plus its error, held in
+    30-70 kg), by hand."""
+    return K_SCHEDULED.at(m3=min(max(r["m3"] + r.get("m3_error", 0.0), 30.0), 70.0))
+
+
 @pytest.mark.slow
-def test_controller_json_is_the_controller_for_every_occupant(run):
+def test_controller_json_is_the_scheduled_controller_with_its_schedule(run):
     K, meta = load_controller(run.out / "controller.json")
-    for name in "ABCD":
-        assert np.array_equal(np.asarray(getattr(K, name)), np.asarray(getattr(K_OCCUPANTS, name)))
-    assert list(K.input_labels) == ["x1", "x3"] and list(K.output_labels) == ["u"]
-    assert meta["exported_as"] == "mu_occupants" and meta["version"]
-    assert meta["description"] == "stand-in occupants"
-    # what this run recomputed (the stand-in certificate's µ), and no claim of a
-    # discretisation this file does not hold
+    # the schedule itself, loaded as one, exactly: bit for bit at the nodes and between
+    assert isinstance(K, GriddedController) and K.names == ("m3",)
+    for m3 in (30.0, 50.0, 70.0):
+        assert _same(K.at(m3=m3), K_SCHEDULED.at(m3=m3))
+    K2, _ = load_controller(run.out / "controllers" / "mu_scheduled.json")
+    assert _same(K2.at(m3=41.0), K_SCHEDULED.at(m3=41.0))
+    assert meta["exported_as"] == "mu_scheduled" and meta["version"]
+    assert meta["description"] == "stand-in scheduled"
+    # what this run recomputed: the stand-in certificate's µ at the nominal seat, and the
+    # 1 kHz loop at both nodes
     assert meta["paper_mu_nominal_seat"] == {"upper": 1.2, "lower": 1.1}
-    assert "discretisation" not in meta
+    assert [n["point"] for n in meta["sampled_1khz"]["nodes"]] == [{"m3": 30.0}, {"m3": 70.0}]
     data = json.loads((run.out / "summary.json").read_text())
-    assert data["exported"] == "mu_occupants"
-    # the Monte-Carlo ran on it: one of its rows recomputed with K_OCCUPANTS
-    row = read_results(run.out / "monte_carlo")[0].to_pylist()[0]
-    seat = SeatParameters(**{n: row[n] for n in ("m3", "k1", "k2", "k3", "c1", "c2", "c3")})
-    road = bump(t_end=R._QUICK.bump_t_end, dt=1e-3)
-    direct = simulate(K_OCCUPANTS, road, delay=row["delay"], params=seat,
+    assert data["exported"] == "mu_scheduled"
+    assert any(f.startswith("controller.json is a stand-in") for f in data["facts"])
+    # its row of the table is the schedule at the nominal seat (43.3 kg), simulated here
+    road = bump(t_end=R._QUICK.bump_t_end, dt=R._QUICK.road_dt)
+    direct = simulate(K_SCHEDULED.at(m3=43.3), road, delay=0.025,
                       dt=R._QUICK.sim_dt).metrics()
-    assert row["peak_z3dd"] == pytest.approx(direct.peak_z3dd, rel=1e-9)
+    assert run.summary.controller("mu_scheduled").peak_z3dd[-1] == pytest.approx(
+        direct.peak_z3dd, rel=1e-9)
+    # the Monte-Carlo ran it at each sample's estimate: its true mass plus an error drawn
+    # in ±5 kg; one row recomputed with the schedule there
+    mc = data["monte_carlo"]
+    assert mc["estimate_errors"] == {"m3": 5.0}
+    rows = read_results(run.out / "monte_carlo")[0].to_pylist()
+    assert all(-5.0 <= r["m3_error"] <= 5.0 for r in rows)
+    r = rows[0]
+    seat = SeatParameters(**{n: r[n] for n in ("m3", "k1", "k2", "k3", "c1", "c2", "c3")})
+    direct = simulate(_scheduled_at(r), road, delay=r["delay"], params=seat,
+                      dt=R._QUICK.sim_dt).metrics()
+    assert r["peak_z3dd"] == pytest.approx(direct.peak_z3dd, rel=1e-9)
+    # for MATLAB: the node controllers as an array of models
+    from scipy.io import loadmat
+
+    mat = loadmat(run.out / "controller.mat")
+    assert mat["A"].shape[-1] == 2 and np.array_equal(mat["D"][..., 1], K_SCHEDULED.at(m3=70.0).D)
+    assert mat["P"].ravel().tolist() == [30.0, 70.0]
+
+
+@pytest.mark.slow
+def test_ratio_over_mass_is_each_controller_against_each_seats_own_limit(run):
+    """ratio_over_mass.png's data: the schedule and the robust controller at every mass
+    of the quick grid and the per-mass controllers at their own masses; one point of each
+    recomputed here from its own limit (the LP) and a direct simulation."""
+    data = json.loads((run.out / "summary.json").read_text())["ratio_over_mass"]
+    curves = {c["label"]: c for c in data["curves"]}
+    assert set(curves) == {"µ, scheduled (controller.json)", "µ, every occupant (robust)",
+                           R._PER_MASS}
+    assert curves[R._PER_MASS]["m3"] == [43.3, 60.0]
+    assert data["m3"] == [30.0, 43.3, 50.0, 60.0, 70.0]
+    cfg = R._QUICK
+    road = bump(t_end=cfg.map_t_end, dt=1e-3)
+    for label, K, m in (("µ, scheduled (controller.json)", K_SCHEDULED.at(m3=60.0), 60.0),
+                        ("µ, every occupant (robust)", K_OCCUPANTS, 30.0),
+                        (R._PER_MASS, K_CONSTRAINED, 60.0)):
+        seat = SeatParameters(m3=m)
+        own = bump_limit(road, seat, dt=cfg.limit_dt).certified_peak
+        peak = max(simulate(K, road, delay=d, params=seat, u_max=np.inf, dt=cfg.map_step)
+                   .metrics().peak_z3dd for d in cfg.map_delays)
+        c = curves[label]
+        assert c["ratio"][c["m3"].index(m)] == pytest.approx(peak / own, rel=1e-9)
+    v = {x["m3"]: x for x in data["scheduled_vs_per_mass"]}
+    assert v[60.0]["scheduled_over_per_mass"] == pytest.approx(
+        v[60.0]["scheduled"] / v[60.0]["per_mass"], rel=1e-12)
+    assert "at 60 kg the schedule is" in " ".join(R.comparison_table(run.summary).split())
 
 
 @pytest.mark.slow
@@ -298,13 +372,18 @@ def test_occupant_map_is_what_direct_computations_give(run):
     data = json.loads((run.out / "summary.json").read_text())
     grid = data["occupant_map"]
     rows = read_results(run.out / "occupant_map")[0].to_pylist()
+    # the robust controller's cells beside controller.json's, on the same grid
+    assert {r["controller"] for r in rows} == {str(run.out / "controller.json"),
+                                               str(run.out / "controllers" / "mu_occupants.json")}
+    rows = [r for r in rows if r["controller"] == str(run.out / "controller.json")]
     cfg = R._QUICK
     assert grid["cells"] == len(rows) == len(cfg.map_m3) * len(cfg.map_k1_rel) * len(
         cfg.map_delays)
     p0 = SeatParameters()
     assert sorted({r["k1"] for r in rows}) == pytest.approx(
         sorted(p0.k1 * (1 + x) for x in cfg.map_k1_rel), rel=1e-12)
-    unstable = [not closed_loop_stable(K_OCCUPANTS, r["delay"],
+    # each cell runs the schedule at its own mass
+    unstable = [not closed_loop_stable(_scheduled_at(r), r["delay"],
                                        SeatParameters(m3=r["m3"], k1=r["k1"])) for r in rows]
     # the k1 -50 % cells (outside the set) are unstable, the others are not
     assert grid["unstable_cells"] == sum(unstable) == 2 and grid["failed_cells"] == 0
@@ -318,7 +397,7 @@ def test_occupant_map_is_what_direct_computations_give(run):
     seat = SeatParameters(m3=w["m3"], k1=w["k1"])
     road = bump(t_end=cfg.map_t_end, dt=1e-3)
     own = bump_limit(road, seat, dt=2e-3).certified_peak
-    direct = simulate(K_OCCUPANTS, road, delay=w["delay"], params=seat, dt=cfg.map_step)
+    direct = simulate(_scheduled_at(w), road, delay=w["delay"], params=seat, dt=cfg.map_step)
     assert w["limit_ratio"] == pytest.approx(np.max(np.abs(direct.z3dd)) / own, rel=1e-9)
     # the force the controller commanded (before the delay and the clipping), and the one
     # applied after them
@@ -328,7 +407,16 @@ def test_occupant_map_is_what_direct_computations_give(run):
     # the figure's run is the worst cell replayed: the same seat, delay, road and peak
     assert w["replayed_peak_z3dd"] == pytest.approx(w["peak_z3dd"], rel=1e-12)
     table = R.comparison_table(run.summary)
-    assert "controller.json (µ, every occupant)" in table
+    assert "controller.json (µ, scheduled)" in table
+    # the robust controller on the same map, beside it: its worst cell recomputed
+    other = grid["compared"]["mu_occupants"]
+    wo = other["worst_in_set"]
+    seat_o = SeatParameters(m3=wo["m3"], k1=wo["k1"])
+    direct_o = simulate(K_OCCUPANTS, road, delay=wo["delay"], params=seat_o, dt=cfg.map_step)
+    own_o = bump_limit(road, seat_o, dt=2e-3).certified_peak
+    assert wo["limit_ratio"] == pytest.approx(np.max(np.abs(direct_o.z3dd)) / own_o, rel=1e-9)
+    assert other["cells"] == grid["cells"]
+    assert "µ, every occupant (mu_occupants.json) on the same map" in " ".join(table.split())
     assert f"{w['limit_ratio']:.2f} × its own limit" in table
     # the set's worst force and stroke by search (quick: the 128 corners at the run's
     # two delays), each attained at its seat by a direct simulation
@@ -336,7 +424,10 @@ def test_occupant_map_is_what_direct_computations_give(run):
         found = grid["searched"][key]
         assert found["evaluations"] == 128 and found["delay"] in (0.0, 0.025)
         seat = SeatParameters(**found["seat"])
-        m = simulate(K_OCCUPANTS, bump(), delay=found["delay"], params=seat,
+        # searched at a node, over the masses within the estimate's error of it
+        node = found["scheduled_on"]["m3"]
+        assert node in (30.0, 70.0) and abs(seat.m3 - node) <= 5.0
+        m = simulate(K_SCHEDULED.at(m3=node), bump(), delay=found["delay"], params=seat,
                      u_max=np.inf).metrics()
         assert getattr(m, figure) <= found["value"] <= getattr(m, figure) * 1.01
         assert found["text"] in " ".join(table.split())     # wrapped to the table
@@ -397,8 +488,32 @@ def test_map_worst_text_names_an_unstable_seat_and_an_empty_set():
 
 
 @pytest.mark.slow
+def test_controller_json_falls_back_to_the_robust_design_and_says_so(monkeypatch, tmp_path):
+    """Without the scheduled file, controller.json is the controller for every occupant
+    (the export before issue 62), with its own µ recomputed and no claim of a
+    discretisation, and the run says so."""
+    api, *_ = _stand_in(fail_scheduled=True)
+    monkeypatch.setattr(R, "_design_api", lambda: api)
+    summary = R.reproduce(tmp_path, rng=np.random.default_rng(0), delays=(0.0,), quick=True)
+    K, meta = load_controller(tmp_path / "controller.json")
+    assert _same(K, K_OCCUPANTS) and list(K.input_labels) == ["x1", "x3"]
+    assert meta["exported_as"] == "mu_occupants" and meta["description"] == "stand-in occupants"
+    assert meta["paper_mu_nominal_seat"] == {"upper": 1.2, "lower": 1.1}
+    assert "discretisation" not in meta
+    fact = [f for f in summary.facts if f.startswith("controller.json holds")]
+    assert len(fact) == 1 and "mu_scheduled.json missing" in fact[0]
+    assert "OSError" in summary.controller("mu_scheduled").error
+    data = json.loads((tmp_path / "summary.json").read_text())
+    assert data["exported"] == "mu_occupants" and data["ratio_over_mass"] is None
+    # one controller on the map; no estimate error in the Monte-Carlo
+    assert data["occupant_map"]["compared"] == {} and data["monte_carlo"]["estimate_errors"] == {}
+    assert (tmp_path / "occupant_map.png").is_file()
+    assert not (tmp_path / "ratio_over_mass.png").exists()
+
+
+@pytest.mark.slow
 def test_controller_json_falls_back_to_the_mu_design_and_says_so(monkeypatch, tmp_path):
-    api, K_mu, *_ = _stand_in(fail_occupants=True)
+    api, K_mu, *_ = _stand_in(fail_occupants=True, fail_scheduled=True)
     monkeypatch.setattr(R, "_design_api", lambda: api)
     summary = R.reproduce(tmp_path, rng=np.random.default_rng(0), delays=(0.0,), quick=True)
     K, meta = load_controller(tmp_path / "controller.json")
@@ -406,6 +521,7 @@ def test_controller_json_falls_back_to_the_mu_design_and_says_so(monkeypatch, tm
     assert meta["mu_peak_upper"] == summary.mu_peak
     fact = [f for f in summary.facts if f.startswith("controller.json holds")]
     assert len(fact) == 1 and "mu_occupants.json missing" in fact[0]
+    assert "mu_scheduled.json missing" in fact[0]
     assert "OSError" in summary.controller("mu_occupants").error
     data = json.loads((tmp_path / "summary.json").read_text())
     assert data["exported"] == "mu" and data["occupant_map"]["cells"] == 6

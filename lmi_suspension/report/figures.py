@@ -14,7 +14,8 @@ from matplotlib.ticker import NullFormatter
 
 __all__ = ["plot_bounded_response", "plot_commanded_force", "plot_constrained_tradeoff",
            "plot_force_tradeoff", "plot_mu_bounds", "plot_peak_vs_delay", "plot_responses",
-           "plot_occupants", "plot_occupant_tradeoff", "plot_road"]
+           "plot_occupants", "plot_occupant_maps", "plot_occupant_tradeoff",
+           "plot_ratio_over_mass", "plot_road"]
 
 _LABELS = {
     "z3dd": ("upper-body acceleration $\\ddot z_3$", "m/s²"),
@@ -490,4 +491,147 @@ def plot_occupant_tradeoff(points: Sequence, *, worst_goal: float = 1.5,
     for ax in (a1, a2, a3):
         ax.grid(True, alpha=0.3)
     fig.suptitle(title)
+    return fig
+
+
+def plot_occupant_maps(panels: Sequence[Mapping], *, box=None, title: str = "") -> Figure:
+    """Controllers side by side over occupant mass × seat spring, on one colour scale.
+
+    Parameters
+    ----------
+    panels : sequence of mapping
+        One per controller: ``title``; ``m3`` and ``k1``, the grid's values (kg, N/m);
+        ``ratio``, a ``len(k1) × len(m3)`` array of each cell's worst peak ``|z̈3|`` over
+        its own limit (nan where there is none); ``stable``, a boolean array of the same
+        shape (unstable cells are hatched, the boundary drawn in red); ``worst``,
+        ``(m3, k1)`` of the worst cell of the set, or None.
+    box : ((float, float), (float, float)), optional
+        The set's ``m3`` and ``k1`` ranges, drawn on every panel.
+    title : str
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        One panel per controller and one colour bar: the colour scale is the same on
+        every panel (from the smallest stable ratio of all panels to the 98th percentile
+        of all), so a colour means one ratio wherever it is.
+
+    Examples
+    --------
+    >>> grid = dict(m3=[30.0, 70.0], k1=[20000.0, 31000.0])
+    >>> a = dict(grid, title="a", ratio=np.array([[2.0, 3.0], [1.5, 2.5]]),
+    ...          stable=np.array([[False, True], [True, True]]), worst=(70.0, 31000.0))
+    >>> b = dict(grid, title="b", ratio=np.array([[1.2, 1.4], [1.1, 1.3]]),
+    ...          stable=np.ones((2, 2), bool), worst=None)
+    >>> fig = plot_occupant_maps([a, b], box=((30.0, 70.0), (24800.0, 37200.0)))
+    >>> [ax.get_title() for ax in fig.axes[:2]], fig.axes[0].collections[0].norm.vmin
+    (['a', 'b'], 1.1)
+    """
+    from matplotlib.colors import Normalize
+    from matplotlib.patches import Rectangle
+
+    if not panels:
+        raise ValueError("no panels to draw")
+    shown = [np.where(np.asarray(p["stable"], bool), np.asarray(p["ratio"], float), np.nan)
+             for p in panels]
+    finite = np.concatenate([v[np.isfinite(v)] for v in shown])
+    norm = Normalize(vmin=float(finite.min()) if finite.size else 0.0,
+                     vmax=float(np.percentile(finite, 98)) if finite.size else 1.0)
+    fig = Figure(figsize=(5.6 * len(panels) + 1.0, 4.8), layout="constrained")
+    axes = fig.subplots(1, len(panels), sharey=True, squeeze=False)[0]
+    mesh = None
+    for ax, p, z in zip(axes, panels, shown):
+        xs, ys = np.asarray(p["m3"], float), np.asarray(p["k1"], float)
+        stable = np.asarray(p["stable"], bool)
+        mesh = ax.pcolormesh(xs, ys, z, shading="nearest", cmap="viridis", norm=norm)
+        if not stable.all():
+            ax.pcolor(xs, ys, np.where(stable, np.nan, 1.0), shading="nearest", hatch="//",
+                      cmap="Greys", vmin=0, vmax=3, alpha=0.6)
+            if stable.any():
+                ax.contour(xs, ys, stable.astype(float), levels=[0.5], colors="red",
+                           linewidths=2.0)
+            ax.plot([], [], color="red", lw=2, label="stability boundary (hatched: unstable)")
+        if box is not None:
+            (m_lo, m_hi), (k_lo, k_hi) = box
+            ax.add_patch(Rectangle((m_lo, k_lo), m_hi - m_lo, k_hi - k_lo, fill=False,
+                                   ec="white", ls="--", lw=1.5,
+                                   label=f"the set ({m_lo:g}-{m_hi:g} kg, "
+                                         f"{k_lo:.0f}-{k_hi:.0f} N/m)"))
+        if p.get("worst") is not None:
+            ax.plot(*p["worst"], "o", ms=14, mfc="none", mec="r", label="worst in the set")
+        finite_p = z[np.isfinite(z)]
+        if finite_p.size:
+            # each cell's number: the map is small, and the comparison is the point
+            for i, k1 in enumerate(ys):
+                for j, m3 in enumerate(xs):
+                    if np.isfinite(z[i, j]):
+                        ax.text(m3, k1, f"{z[i, j]:.2f}", ha="center", va="center",
+                                fontsize=7, color="w" if norm(z[i, j]) < 0.6 else "k")
+        ax.set_title(p["title"], fontsize=10)
+        ax.set_xlabel("upper-body mass m3 [kg]")
+        ax.legend(loc="upper left", fontsize=7)
+    axes[0].set_ylabel("seat spring k1 [N/m]")
+    fig.colorbar(mesh, ax=list(axes), label="worst peak |z3''| / own limit (stable cells)")
+    if title:
+        fig.suptitle(title, fontsize=10)
+    return fig
+
+
+def plot_ratio_over_mass(curves: Sequence, *, per_mass: str | None = None,
+                         within: float = 1.2, title: str = "") -> Figure:
+    """Peak ``|z̈3|`` over each seat's own limit against the occupant's mass, one line per
+    controller (:func:`~lmi_suspension.seat.schedule_use.ratio_over_mass`'s curves).
+
+    Parameters
+    ----------
+    curves : sequence of MassRatioCurve
+        Anything with ``label``, ``m3`` and ``ratio`` (inf: unstable, drawn as a cross at
+        the top of the axes).
+    per_mass : str, optional
+        The label of the curve of controllers each tuned for exactly its mass: drawn as
+        points, with ``within`` times it as a dashed band (issue 62's target: a scheduled
+        controller within 1.2 × of it).
+    within : float
+    title : str
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace as C
+    >>> fig = plot_ratio_over_mass([C(label="a", m3=(30.0, 50.0, 70.0), ratio=(2.0, 2.4, 2.2)),
+    ...                             C(label="b", m3=(30.0, 50.0, 70.0), ratio=(1.5, np.inf, 1.3)),
+    ...                             C(label="tuned", m3=(43.3,), ratio=(1.4,))],
+    ...                            per_mass="tuned")
+    >>> len(fig.axes[0].lines)      # a, b, b's unstable mass, tuned, 1.2 × tuned, the limit
+    6
+    """
+    fig = Figure(figsize=(7.2, 4.6), layout="constrained")
+    ax = fig.subplots()
+    finite = [r * (within if c.label == per_mass else 1.0) for c in curves for r in c.ratio
+              if np.isfinite(r)]
+    top = 1.1 * max(finite) if finite else 2.0
+    for k, c in enumerate(curves):
+        m, r = np.asarray(c.m3, float), np.asarray(c.ratio, float)
+        color = f"C{k}"
+        if c.label == per_mass:
+            ax.plot(m, r, "*", ms=14, color=color, label=c.label)
+            ax.plot(m, within * r, "_", ms=24, mew=2, color=color,
+                    label=f"{within:g} × that (the target for a scheduled controller)")
+            continue
+        ok = np.isfinite(r)
+        ax.plot(m, np.where(ok, r, np.nan), "o-", color=color, label=c.label)
+        if not ok.all():
+            ax.plot(m[~ok], np.full((~ok).sum(), top), "x", ms=10, color=color,
+                    label=f"{c.label}: unstable")
+    ax.axhline(1.0, color="k", lw=0.8, ls=":", label="the seat's own limit")
+    ax.set_xlabel("upper-body mass m3 [kg] (every other parameter Table 1's)")
+    ax.set_ylabel("worst peak $|\\ddot z_3|$ over delays / own limit")
+    ax.set_ylim(0.9, top * 1.05)
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8)
+    if title:
+        ax.set_title(title, fontsize=10)
     return fig

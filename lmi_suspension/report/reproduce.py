@@ -4,11 +4,14 @@
 7–15 of the paper plus the peak-versus-delay study), ``summary.json`` and ``controller.json``
 into one directory. :func:`comparison_table` formats the headline figures as text.
 
-``controller.json`` is the shipped controller for every occupant (30–70 kg, springs and
-dampers ±20 %, delay 0–25 ms; :data:`~lmi_suspension.seat.multimodel.SHIPPED_OCCUPANTS`),
-not this run's µ design: the µ design goes unstable once the seat spring is about 17 %
-soft (issue 38), and a user who takes the run's controller takes it to a seat that is not
-the nominal one.  The µ design is ``controllers/mu.json``.
+``controller.json`` is the shipped seat controller scheduled on what the seat measures
+(issue 62, :data:`~lmi_suspension.seat.schedule_use.SHIPPED_SCHEDULED`), with its
+schedule; where that cannot be loaded, the shipped controller for every occupant (30–70
+kg, springs and dampers ±20 %, delay 0–25 ms;
+:data:`~lmi_suspension.seat.multimodel.SHIPPED_OCCUPANTS`); never this run's µ design: the
+µ design goes unstable once the seat spring is about 17 % soft (issue 38), and a user who
+takes the run's controller takes it to a seat that is not the nominal one.  The µ design
+is ``controllers/mu.json``.
 
 Deviation from the paper, on purpose: the white-noise floor velocity has a two-sided PSD of
 ``1e-4`` (m/s)²/Hz in a 50 Hz band (about the level of an ISO 8608 class-C road at 30 km/h),
@@ -45,24 +48,34 @@ logger = logging.getLogger(__name__)
 
 #: Names of the compared controllers, in table order.
 CONTROLLER_NAMES = ("passive", "hinf_lmi_nominal", "hinf_riccati", "mu", "mu_constrained",
-                    "mu_refined", "mu_occupants", "mu_1khz")
+                    "mu_refined", "mu_occupants", "mu_1khz", "mu_scheduled")
 #: the controller written to ``controller.json`` (the one ``simulate``, ``sweep`` and a
-#: user take): the shipped design for every occupant, spring and delay of the set
-#: (:data:`~lmi_suspension.seat.multimodel.SHIPPED_OCCUPANTS`); the µ design where it
-#: cannot be loaded (the summary's facts then say so)
-EXPORTED = "mu_occupants"
+#: user take): the shipped seat controller scheduled on what the seat measures (issue 62,
+#: :data:`~lmi_suspension.seat.schedule_use.SHIPPED_SCHEDULED`), with its schedule; where
+#: it cannot be loaded the design for every occupant, spring and delay of the set
+#: (:data:`~lmi_suspension.seat.multimodel.SHIPPED_OCCUPANTS`), else the µ design (the
+#: summary's facts then say so)
+EXPORTED = "mu_scheduled"
+#: the robust controller the exported one is compared with on the map and over the mass
+ROBUST = "mu_occupants"
+#: the estimate errors a scheduled controller is evaluated with in the Monte-Carlo where
+#: its file's metadata gives none (``estimate_errors``): issue 62's ±5 kg on the mass
+_ESTIMATE_ERRORS = {"m3": 5.0}
 #: the stages of :func:`reproduce`, in order: each announces itself with one progress
 #: message that does not start with a space (details follow indented), and its wall time
 #: is ``summary.json``'s ``timings[name]``
 STAGES = ("mu_design", "mu_analysis", "mu_constrained", "mu_refined", "mu_occupants",
-          "mu_1khz", "hinf_lmi_nominal", "hinf_riccati",
+          "mu_1khz", "mu_scheduled", "hinf_lmi_nominal", "hinf_riccati",
           "limit",
           *(f"simulate_{n}" for n in CONTROLLER_NAMES), "iso_C", "monte_carlo",
-          "occupant_map", "worst_seats", "figures")
+          "occupant_map", "worst_seats", "ratio_over_mass", "figures")
 _LONG_NAMES = {"passive": "passive", "hinf_lmi_nominal": "H∞ LMI (no delay)",
                "hinf_riccati": "H∞ Riccati", "mu": "µ (D-K)",
                "mu_constrained": "µ, hard bounds", "mu_refined": "µ, refined",
-               "mu_occupants": "µ, every occupant", "mu_1khz": "µ at 1 kHz"}
+               "mu_occupants": "µ, every occupant", "mu_1khz": "µ at 1 kHz",
+               "mu_scheduled": "µ, scheduled"}
+#: the curve of controllers each tuned for exactly its mass (ratio_over_mass.png)
+_PER_MASS = "tuned for exactly that mass"
 #: sample time of every controller's discrete realization in controllers/<name>.json
 _SAMPLE_TIME = 1e-3
 
@@ -94,6 +107,9 @@ class _Settings:
     #: besides the 128 corners, and climbs per figure
     search_n: int = 200
     search_starts: int = 3
+    #: the masses of the ratio-over-mass figure (kg; the per-mass controllers' own
+    #: masses are added)
+    ratio_m3: tuple = (30.0, 35.0, 40.0, 45.0, 50.0, 55.0, 60.0, 65.0, 70.0)
 
 
 # The map reaches past the set (m3 30-70 kg, k1 ±20 %) far enough to show where the
@@ -111,24 +127,28 @@ _FULL = _Settings(bump_t_end=3.0, noise_t_end=3.0, iso_t_end=3.0, road_dt=1e-3, 
 _QUICK = _Settings(bump_t_end=1.5, noise_t_end=1.0, iso_t_end=1.0, road_dt=1e-3, sim_dt=5e-4,
                    limit_dt=5e-3, mc_n=4, mc_workers=0, map_m3=(30.0, 70.0),
                    map_k1_rel=(-0.5, 0.0, 0.2), map_delays=(0.025,), map_step=5e-4, map_t_end=1.5,
-                   search_n=0, search_starts=0)
+                   search_n=0, search_starts=0, ratio_m3=(30.0, 50.0, 70.0))
 
 
 def _monte_carlo(controller: Path, cfg: _Settings, delay_range, params, seed: int,
-                 nominal_limit: float, road) -> dict:
+                 nominal_limit: float, road, estimate_errors: Mapping | None = None) -> dict:
     """The Monte-Carlo over the uncertainty set as a sweep (:mod:`lmi_suspension.sweep`):
     ``cfg.mc_n`` cases on ``cfg.mc_workers`` Dask workers, each also tested for linear
     stability with its exact delay; the table and its trade-off figure go to
     ``monte_carlo/`` beside the other results.  The samples are drawn over the set the
     exported controller is designed for (:class:`~lmi_suspension.seat.occupants.OccupantSet`:
-    m3, every spring and damper), as the occupant map's box is.  Returns the summary's
-    ``monte_carlo`` entry."""
+    m3, every spring and damper), as the occupant map's box is; a scheduled controller
+    runs at each sample's values plus an estimate error drawn in ``±estimate_errors[name]``
+    (the sweep's ``<name>_error`` axes).  Returns the summary's ``monte_carlo`` entry."""
     from ..seat.occupants import OccupantSet
     from ..sweep import SweepSpec, read_results, run_sweep
+    from ..sweep.spec import PLANT_AXES
 
     ranges = [(n, float(lo), float(hi)) for n, lo, hi in OccupantSet(nominal=params).ranges()]
     if delay_range[1] > delay_range[0]:
         ranges.append(("delay", float(delay_range[0]), float(delay_range[1])))
+    errors = {n: float(e) for n, e in (estimate_errors or {}).items() if e > 0}
+    ranges += [(f"{n}_error", -e, e) for n, e in errors.items()]
     # the nominal seat's limit only (one LP per sample cost 0.34 s, twice the simulation)
     spec = SweepSpec(controllers=(str(controller),), samples=cfg.mc_n, ranges=tuple(ranges),
                      road="bump", duration=float(road.t[-1]), seed=seed, limit=False,
@@ -152,13 +172,14 @@ def _monte_carlo(controller: Path, cfg: _Settings, delay_range, params, seed: in
         from ..seat import bump_limit
 
         seat = dataclasses.replace(params, **{n: worst[n] for n, _, _ in ranges
-                                              if n != "delay"})
+                                              if n in PLANT_AXES})
         try:
             own = bump_limit(road, seat, dt=cfg.limit_dt).certified_peak
         except LmiSuspensionError as exc:
             logger.info("Monte-Carlo: no limit for its worst sample (%s)", exc)
     return {
         "n": cfg.mc_n, "ranges": {n: [lo, hi] for n, lo, hi in ranges if n != "delay"},
+        "estimate_errors": errors,
         "delay_range": [float(d) for d in delay_range], "seed": seed,
         "peak_z3dd": [r["peak_z3dd"] for r in rows],
         "delays": [r.get("delay", float(delay_range[0])) for r in rows],
@@ -172,22 +193,27 @@ def _monte_carlo(controller: Path, cfg: _Settings, delay_range, params, seed: in
     }
 
 
-def _occupant_map(controller: Path, cfg: _Settings, params, seed: int) -> tuple:
+def _occupant_map(controller: Path, cfg: _Settings, params, seed: int,
+                  compare: Mapping | None = None) -> tuple:
     """The exported controller over occupant mass × seat spring: a grid sweep
     (:mod:`lmi_suspension.sweep`, ``cfg.mc_workers`` Dask workers) of ``m3`` × ``k1`` ×
     delay on the bump, each cell's peak ``|z̈3|`` over *its own* physical limit (the LP of
-    :func:`~lmi_suspension.seat.bump_limit` for that seat) and its exact-delay stability.
-    The table goes to ``occupant_map/``.  Returns ``(entry, table, spec, worst)``: the
-    summary's ``occupant_map`` entry, the sweep's table and spec, and the worst row inside
-    the set: the first unstable one in case order if any, else the one of the largest
-    ratio (cases that raised, and cells whose limit LP failed, are counted apart, never
-    the worst)."""
+    :func:`~lmi_suspension.seat.bump_limit` for that seat) and its exact-delay stability;
+    a scheduled controller runs at each cell's own values (no estimate error).  The
+    controllers of ``compare`` (``{name: file}``) run on the same grid in the same sweep
+    (the limits are computed once per seat).  The table goes to ``occupant_map/``.
+    Returns ``(entry, table, spec, worst)``: the summary's ``occupant_map`` entry (the
+    compared controllers' under ``entry["compared"][name]``), the sweep's table and
+    spec, and the exported controller's worst row inside the set: the first unstable
+    one in case order if any, else the one of the largest ratio (cases that raised, and
+    cells whose limit LP failed, are counted apart, never the worst)."""
     from ..seat.occupants import OccupantSet
     from ..sweep import SweepSpec, read_results, run_sweep
 
+    compare = dict(compare or {})
     ranges = dict((n, (lo, hi)) for n, lo, hi in OccupantSet(nominal=params).ranges())
     k1_values = tuple(params.k1 * (1 + r) for r in cfg.map_k1_rel)
-    spec = SweepSpec(controllers=(str(controller),),
+    spec = SweepSpec(controllers=(str(controller), *(str(c) for c in compare.values())),
                      grid=(("m3", cfg.map_m3), ("k1", k1_values), ("delay", cfg.map_delays)),
                      road="bump", duration=cfg.map_t_end, seed=seed, limit=True,
                      step=cfg.map_step)
@@ -197,7 +223,7 @@ def _occupant_map(controller: Path, cfg: _Settings, params, seed: int) -> tuple:
     # its figure is drawn by the caller, with the set's box
     res = run_sweep(spec, out, workers=cfg.mc_workers, figures=False)
     table = read_results(out)[0]
-    rows = table.to_pylist()
+    all_rows = table.to_pylist()
 
     def inside(r):  # a relative tolerance: the grid's k1 are products of floats
         return all(lo * (1 - 1e-9) <= r[n] <= hi * (1 + 1e-9)
@@ -212,28 +238,81 @@ def _occupant_map(controller: Path, cfg: _Settings, params, seed: int) -> tuple:
     def has_ratio(r):  # its limit LP may have failed (nan)
         return r["limit_ratio"] is not None and math.isfinite(r["limit_ratio"])
 
-    in_set = [r for r in rows if inside(r)]
-    unstable_in = [r for r in in_set if unstable(r)]
-    scored = [r for r in in_set if not failed(r) and not unstable(r) and has_ratio(r)]
-    # an unstable seat of the set is its worst (the first in case order); else the ratio
-    worst = unstable_in[0] if unstable_in else (
-        max(scored, key=lambda r: r["limit_ratio"]) if scored else None)
     keep = ("m3", "k1", "delay", "stable", "stable_sim", "peak_z3dd", "limit_peak",
             "limit_ratio", "peak_u", "peak_u_command", "peak_x1", "error")
-    entry = {
+
+    def summarise(path) -> tuple:
+        rows = [r for r in all_rows if r["controller"] == str(path)]
+        in_set = [r for r in rows if inside(r)]
+        unstable_in = [r for r in in_set if unstable(r)]
+        scored = [r for r in in_set if not failed(r) and not unstable(r) and has_ratio(r)]
+        # an unstable seat of the set is its worst (the first in case order); else the ratio
+        worst = unstable_in[0] if unstable_in else (
+            max(scored, key=lambda r: r["limit_ratio"]) if scored else None)
+        return {
+            "controller": str(path), "cells": len(rows),
+            "unstable_cells": sum(unstable(r) for r in rows),
+            "unstable_cells_in_set": len(unstable_in),
+            "failed_cells": sum(failed(r) for r in rows),
+            "cells_in_set_without_limit": sum(not failed(r) and not unstable(r)
+                                              and not has_ratio(r) for r in in_set),
+            "worst_in_set": None if worst is None else {k: worst[k] for k in keep},
+        }, worst
+
+    entry, worst = summarise(controller)
+    entry.update({
         "grid": {"m3": list(cfg.map_m3), "k1": list(k1_values), "delay": list(cfg.map_delays)},
         "set": {"m3": list(ranges["m3"]), "k1": list(ranges["k1"])},
-        "step": cfg.map_step, "cells": len(rows),
-        "unstable_cells": sum(unstable(r) for r in rows),
-        "unstable_cells_in_set": len(unstable_in),
-        "failed_cells": sum(failed(r) for r in rows),
-        "cells_in_set_without_limit": sum(not failed(r) and not unstable(r)
-                                          and not has_ratio(r) for r in in_set),
-        "worst_in_set": None if worst is None else {k: worst[k] for k in keep},
+        "step": cfg.map_step,
         "sweep": {"workers": res.workers, "failed": res.n_failed,
                   "table": "occupant_map/results.parquet"},
-    }
+        "compared": {name: summarise(path)[0] for name, path in compare.items()},
+    })
     return entry, table, spec, worst
+
+
+def _map_panel(table, entry: Mapping, path, title: str) -> dict:
+    """One controller's cells of the occupant map as a panel of
+    :func:`~lmi_suspension.report.figures.plot_occupant_maps`: per (k1, m3) the worst ratio
+    over the delays, stable where every delay is (by the Nyquist count and the
+    simulation)."""
+    m3, k1 = entry["grid"]["m3"], entry["grid"]["k1"]
+    ratio = np.full((len(k1), len(m3)), np.nan)
+    stable = np.ones((len(k1), len(m3)), dtype=bool)
+    for r in table.to_pylist():
+        if r["controller"] != str(path) or r["error"] is not None:
+            continue
+        i = int(np.argmin(np.abs(np.asarray(k1) - r["k1"])))
+        j = int(np.argmin(np.abs(np.asarray(m3) - r["m3"])))
+        if not (r["stable"] and r["stable_sim"]):
+            stable[i, j] = False
+        elif r["limit_ratio"] is not None and math.isfinite(r["limit_ratio"]):
+            ratio[i, j] = np.fmax(ratio[i, j], r["limit_ratio"])
+    worst = entry.get("worst_in_set")
+    return {"title": title, "m3": m3, "k1": k1, "ratio": ratio, "stable": stable,
+            "worst": None if worst is None else (worst["m3"], worst["k1"])}
+
+
+def _save_scheduled_mat(path: Path, Ks, metadata: Mapping) -> Path:
+    """A scheduled controller for MATLAB: its node controllers as an array of models
+    (``A`` n × n × N, ``B``, ``C``, ``D``; ``P`` N × k the nodes, ``ParameterName``),
+    the layout of :func:`~lmi_suspension.io.save_scheduled_mat`; doubles, so the numbers
+    are the file's."""
+    import scipy.io
+
+    from ..seat.schedule_use import schedule_nodes
+
+    nodes = schedule_nodes(Ks)
+    mats = [Ks.at(**p) for p in nodes]
+    data = {M: np.stack([np.asarray(getattr(K, M), dtype=float) for K in mats], axis=-1)
+            for M in "ABCD"}
+    data.update(P=np.array([[p[n] for n in Ks.names] for p in nodes], dtype=float),
+                ParameterName=np.array(list(Ks.names), dtype=object).reshape(-1, 1),
+                InputName=np.array(["x1", "x3"], dtype=object).reshape(-1, 1),
+                OutputName=np.array(["u"], dtype=object).reshape(-1, 1),
+                Description=str(metadata.get("description", "")))
+    scipy.io.savemat(path, data, do_compression=False, oned_as="column")
+    return path
 
 
 @dataclass(frozen=True)
@@ -343,9 +422,12 @@ def _design_api():
     """The seat designs (imported late: they are heavy, and tests replace them)."""
     from types import SimpleNamespace
 
-    from ..seat import augmented, design, record, refine, routes
+    from ..io import load_controller
+    from ..seat import augmented, design, record, refine, routes, schedule_use
     return SimpleNamespace(
         design_seat=routes.design_seat, load_seat_design=routes.load_seat_design,
+        load_scheduled=lambda: load_controller(schedule_use.SHIPPED_SCHEDULED),
+        load_at_mass=lambda: load_controller(schedule_use.SHIPPED_AT_MASS),
         certify_seat=record.certify_seat,
         load_refined_tradeoff=refine.load_refined_tradeoff,
         analyse_uncertainty=design.analyse_uncertainty,
@@ -433,11 +515,17 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     Files written: ``fig07_bump.png`` … ``fig15_mu_bounds.png`` (the paper's figures),
     ``peak_vs_delay.png``, ``iso_C_z3dd.png``, ``summary.json`` (non-finite numbers are
     written as ``null``; a ``null`` delay margin means no loss of stability below 1 s) and
-    ``controller.json`` (the controller for every occupant, ``y = [x1, x3]`` in m to ``u``
-    in N; its µ with the paper's weights at the nominal seat recomputed here, its mixed µ
-    over the set quoted from its design; the µ design only where the shipped file cannot
-    be loaded, which the summary's facts then say) and ``controller.mat``;
-    ``occupant_map.png`` (its map, the set's box and the stability boundary drawn),
+    ``controller.json`` (the controller scheduled on the occupant's measured values, with
+    its schedule, ``y = [x1, x3]`` in m to ``u`` in N; its µ with the paper's weights at
+    the nominal seat and its 1 kHz loop at every scheduling value
+    (:func:`~lmi_suspension.seat.schedule_use.sampled_schedule_check`) recomputed here;
+    the controller for every occupant, then the µ design, where the shipped files cannot
+    be loaded, which the summary's facts then say) and ``controller.mat`` (a scheduled
+    one's node controllers as an array of models); ``occupant_map.png`` (its map beside
+    the robust controller's on one colour scale, the set's box and the stability
+    boundary drawn), ``ratio_over_mass.png`` (peak over each seat's own limit along the
+    mass: the schedule, the robust controller and the controllers tuned for exactly one
+    mass, :data:`~lmi_suspension.seat.schedule_use.SHIPPED_AT_MASS`, at their masses),
     ``occupant_map/`` (the map's sweep table), ``worst_case.png`` (the worst seat of the
     map in the set, on the bump: ``z̈3`` against that seat's own limit, force, stroke);
     ``controllers/<name>.json`` for every designed controller, each with its 1 kHz
@@ -487,8 +575,11 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         are recorded in ``summary.json`` instead).
     """
     from .. import __version__
-    from ..io import save_controller, save_controller_mat
+    from ..errors import InputError
+    from ..io import save_controller, save_controller_mat, save_scheduled_controller
     from ..seat.sampled import discretise_controller, fastest_pole, simulate_sampled
+    from ..seat.schedule_use import (controller_for_seat, is_scheduled,
+                                     sampled_schedule_check, schedule_nodes)
     from ..seat import (
         SeatParameters,
         bump,
@@ -588,6 +679,33 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     at_1khz = shipped(
         "mu_1khz", "discrete", "µ design on the plant sampled at 1 kHz (shipped, "
         "re-certified) ...", lambda c: "")
+    # scheduled on what the seat measures: its schedule is the exported controller; at
+    # the nominal seat it is re-certified with the paper's weights like the others, and
+    # its 1 kHz loop is checked against the continuous one at every scheduling value
+    tok = stage("mu_scheduled", "seat controller scheduled on what the seat measures "
+                "(shipped, re-certified at the nominal seat, 1 kHz loop at every "
+                "scheduling value) ...")
+    scheduled = None
+    try:
+        Ks, meta_s = api.load_scheduled()
+        if not is_scheduled(Ks):
+            raise InputError("mu_scheduled.json does not hold a scheduled controller")
+        K_nom = controller_for_seat(Ks, params)
+        cert_s = api.certify_seat(K_nom, params=params, delays=(), rng=np.random.default_rng(
+            int(rng_analysis.integers(2**63))))
+        check_1k = sampled_schedule_check(
+            Ks, dt=_SAMPLE_TIME, delays=(delays[0], delays[-1]),
+            road=bump(t_end=cfg.bump_t_end, dt=cfg.road_dt), params=params)
+        scheduled = (Ks, dict(meta_s), cert_s, check_1k)
+        say(f"  scheduled on {', '.join(Ks.names)}; at the nominal seat µ upper "
+            f"{cert_s.mu.mu_peak:.4f}, lower {cert_s.mu.mu_lower_peak:.4f}; 1 kHz loop "
+            f"within {check_1k.gap:.2%} of the continuous one at {len(check_1k.nodes)} "
+            f"scheduling values ({'within' if check_1k.passed else 'NOT within'} "
+            f"{check_1k.tolerance:.1%})")
+    except (LmiSuspensionError, OSError, ValueError) as exc:
+        errors["mu_scheduled"] = f"{type(exc).__name__}: {exc}"
+        say(f"  mu_scheduled failed: {errors['mu_scheduled']}")
+    done(tok)
 
     # --- comparison controllers ------------------------------------------------------
     controllers: dict[str, object] = {"passive": None}
@@ -605,6 +723,11 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                          ("mu_occupants", occupants), ("mu_1khz", at_1khz)):
         if loaded is not None:
             controllers[name], discrete[name] = loaded[0].K, loaded[0].Kd
+    if scheduled is not None:
+        # in the comparison: the schedule at the nominal seat's values (and its 1 kHz loop)
+        controllers["mu_scheduled"] = controller_for_seat(scheduled[0], params)
+        discrete["mu_scheduled"] = discretise_controller(controllers["mu_scheduled"],
+                                                         _SAMPLE_TIME, warn_unresolved=False)
 
     # --- roads and the physical limit ------------------------------------------------
     road_bump = bump(t_end=cfg.bump_t_end, dt=cfg.road_dt)
@@ -724,9 +847,19 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     }
     # controller.json is the controller for every occupant; the µ design only where that
     # one could not be loaded (a fact of the summary then says so)
-    exported = EXPORTED if occupants is not None else "mu"
+    exported = (EXPORTED if scheduled is not None else
+                "mu_occupants" if occupants is not None else "mu")
     if exported == "mu":
         K_export, meta_export = mu_design.K, dict(metadata)
+    elif exported == EXPORTED:
+        K_export, meta_export = scheduled[0], dict(scheduled[1])
+        cert_s, check_1k = scheduled[2], scheduled[3]
+        meta_export["paper_mu_nominal_seat"] = {"upper": cert_s.mu.mu_peak,
+                                                "lower": cert_s.mu.mu_lower_peak}
+        meta_export["sampled_1khz"] = {
+            "dt": check_1k.dt, "tolerance": check_1k.tolerance, "gap": check_1k.gap,
+            "passed": check_1k.passed,
+            "nodes": [{"point": n.point, "gap": n.gap} for n in check_1k.nodes]}
     else:
         K_export, meta_export = occupants[0].K, occupants[0].metadata()
         # controllers/mu_occupants.json holds the 1 kHz realization; this file does not
@@ -736,11 +869,20 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         meta_export["paper_mu_nominal_seat"] = {"upper": occupants[1].mu.mu_peak,
                                                 "lower": occupants[1].mu.mu_lower_peak}
     meta_export.update(exported_as=exported, version=__version__)
-    files.append(save_controller(out / "controller.json", K_export, inputs=["x1", "x3"],
-                                 outputs=["u"], metadata=_jsonable(meta_export)))
-    # the same controller for MATLAB / Simulink (lmi-suspension export does it for any file)
-    files.append(save_controller_mat(out / "controller.mat", K_export, inputs=["x1", "x3"],
+    if is_scheduled(K_export):
+        # the schedule itself, exactly (io.load_controller gives it back, at() bit for bit)
+        files.append(save_scheduled_controller(out / "controller.json", K_export,
+                                               metadata=_jsonable(meta_export)))
+        # for MATLAB / Simulink: the node controllers as an array of models
+        files.append(_save_scheduled_mat(out / "controller.mat", K_export, meta_export))
+    else:
+        files.append(save_controller(out / "controller.json", K_export, inputs=["x1", "x3"],
                                      outputs=["u"], metadata=_jsonable(meta_export)))
+        # the same controller for MATLAB / Simulink (lmi-suspension export does it for any
+        # file)
+        files.append(save_controller_mat(out / "controller.mat", K_export,
+                                         inputs=["x1", "x3"], outputs=["u"],
+                                         metadata=_jsonable(meta_export)))
     # every designed controller, with its 1 kHz Tustin realization (the constrained one's
     # own; a controller with poles above the Nyquist rate is discretised all the same:
     # that is a fact about the design, which the summary's facts and the table report,
@@ -748,6 +890,12 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     (out / "controllers").mkdir(exist_ok=True)
     for name, K in controllers.items():
         if K is None:
+            continue
+        if name == "mu_scheduled":   # the schedule, as controller.json holds it
+            files.append(save_scheduled_controller(
+                out / "controllers" / f"{name}.json", scheduled[0],
+                metadata=_jsonable(dict(scheduled[1], fastest_pole=max(
+                    fastest_pole(scheduled[0].at(**p)) for p in schedule_nodes(scheduled[0]))))))
             continue
         Kd = discrete.get(name) or discretise_controller(K, _SAMPLE_TIME,
                                                          warn_unresolved=False)
@@ -762,8 +910,13 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                                      discrete=Kd))
     tok = stage("monte_carlo", f"Monte-Carlo over the uncertainty set ({cfg.mc_n} samples, "
                 f"{_LONG_NAMES[exported]}, {cfg.mc_workers or 'no'} Dask workers) ...")
+    estimate_errors = None
+    if is_scheduled(K_export):
+        given = meta_export.get("estimate_errors") or _ESTIMATE_ERRORS
+        estimate_errors = {n: float(e) for n, e in given.items() if n in K_export.names}
     mc_data = _monte_carlo(out / "controller.json", cfg, (delays[0], delays[-1]), params,
-                           int(rng_mc.integers(2**63)), limit.peak, road_bump)
+                           int(rng_mc.integers(2**63)), limit.peak, road_bump,
+                           estimate_errors)
     files.append(out / "monte_carlo")  # results.parquet, tradeoff.png, spec.json, parts/
     done(tok)
     worst = mc_data["worst"]
@@ -773,14 +926,17 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     n_map = len(cfg.map_m3) * len(cfg.map_k1_rel) * len(cfg.map_delays)
     tok = stage("occupant_map", f"occupant mass × seat spring map ({n_map} cells, "
                 f"{_LONG_NAMES[exported]}, each seat's own limit) ...")
+    compare = ({ROBUST: out / "controllers" / f"{ROBUST}.json"}
+               if exported != ROBUST and ROBUST in controllers else {})
     map_data, map_table, map_spec, map_worst = _occupant_map(
-        out / "controller.json", cfg, params, int(rng_mc.integers(2**63)))
+        out / "controller.json", cfg, params, int(rng_mc.integers(2**63)), compare)
     files.append(out / "occupant_map")
     worst_run = None
     if map_worst is not None:
         worst_seat = dataclasses.replace(params, m3=map_worst["m3"], k1=map_worst["k1"])
-        # the map's road and step: the figure's run is the map's case, replayed
-        worst_run = simulate(K_export, bump(t_end=cfg.map_t_end, dt=1e-3),
+        # the map's road and step: the figure's run is the map's case, replayed (a
+        # scheduled controller at that seat's values, as the map ran it)
+        worst_run = simulate(controller_for_seat(K_export, worst_seat), bump(t_end=cfg.map_t_end, dt=1e-3),
                              delay=map_worst["delay"], params=worst_seat, dt=cfg.map_step)
         map_data["worst_in_set"]["replayed_peak_z3dd"] = float(
             np.max(np.abs(worst_run.z3dd)))
@@ -791,10 +947,23 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
         + _map_worst_text(map_data["worst_in_set"]))
     # the set's corners, where the force peaks and which the map's plane does not reach
     tok = stage("worst_seats", "the set's largest force and stroke, by search ...")
-    searched = _searched_worst(K_export, params, delays, cfg, search_seed)
-    map_data["searched"] = {w.figure: w.as_dict() for w in searched}
+    searched = _searched_worst(K_export, params, delays, cfg, search_seed,
+                               (estimate_errors or {}).get("m3", 0.0))
+    map_data["searched"] = {w.figure: dict(w.as_dict(), scheduled_on=on)
+                            for w, on in searched}
+    searched = [w for w, _on in searched]
     done(tok)
     say("  " + _searched_text(map_data["searched"]))
+    # the price of robustness along the mass: the exported schedule, the robust controller
+    # and controllers each tuned for exactly one mass (the best a schedule could do)
+    ratio_data, ratio_curves = None, ()
+    if is_scheduled(K_export):
+        tok = stage("ratio_over_mass", "peak ratio over the occupant's mass (scheduled, "
+                    "robust, tuned for exactly that mass) ...")
+        ratio_data, ratio_curves = _ratio_over_mass(
+            K_export, controllers.get(ROBUST), api, cfg, params, errors)
+        done(tok)
+        say("  " + _ratio_text(ratio_data))
 
     # --- figures ---------------------------------------------------------------------
     tok = stage("figures", "writing figures ...")
@@ -830,9 +999,12 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                                 np.asarray(mu_design.mu_lower),
                                 title="Fig. 15: µ bounds of the closed loop (µ controller)"),
          "fig15_mu_bounds.png")
-    peaks = {_LONG_NAMES[s.name]: list(s.peak_z3dd) for s in summaries
+    def shown_name(name):  # the exported design, named as the file a user takes
+        return _LONG_NAMES[name] + (" = controller.json" if name == exported else "")
+
+    peaks = {shown_name(s.name): list(s.peak_z3dd) for s in summaries
              if s.name != "passive" and not s.error}
-    stable = {_LONG_NAMES[s.name]: list(s.stable) for s in summaries
+    stable = {shown_name(s.name): list(s.stable) for s in summaries
               if s.name != "passive" and not s.error}
     passive_peak = summaries[0].peak_z3dd[0]
     save(figures.plot_peak_vs_delay(delays, peaks, limit=limit.peak, passive=passive_peak,
@@ -871,8 +1043,22 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
             label="refined designs (shipped)", bound_label="force bound of the refinement",
             title="Bump peak against the force bound (refined µ designs)"),
             "tradeoff_refined.png")
-    map_fig = _plot_occupant_map(map_table, map_spec, out / "controller.json", map_data,
-                                 _LONG_NAMES[exported])
+    if map_data["compared"]:
+        panels = [_map_panel(map_table, map_data, out / "controller.json",
+                             f"controller.json ({_LONG_NAMES[exported]}"
+                             + (", run at each seat's own values" if is_scheduled(K_export)
+                                else "") + ")")]
+        for name, entry in map_data["compared"].items():
+            panels.append(_map_panel(map_table, dict(entry, grid=map_data["grid"]),
+                                     compare[name], f"{_LONG_NAMES[name]} ({name}.json)"))
+        delays_map = ", ".join(format(d * 1e3, "g") for d in cfg.map_delays)
+        map_fig = figures.plot_occupant_maps(
+            panels, box=(tuple(map_data["set"]["m3"]), tuple(map_data["set"]["k1"])),
+            title=f"worst peak |z3''| / own limit over delays {delays_map} ms "
+                  f"(one colour scale)")
+    else:
+        map_fig = _plot_occupant_map(map_table, map_spec, out / "controller.json", map_data,
+                                     _LONG_NAMES[exported])
     if map_fig is not None:
         import matplotlib.pyplot as plt
 
@@ -892,6 +1078,11 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                                     label="this seat's limit (LP)" if sign > 0 else None)
             fig.axes[0].legend(fontsize=8, loc="upper right")
         save(fig, "worst_case.png")
+    if ratio_curves:
+        save(figures.plot_ratio_over_mass(
+            ratio_curves, per_mass=_PER_MASS,
+            title=f"Bump at {', '.join(format(d * 1e3, 'g') for d in cfg.map_delays)} ms: "
+                  f"each seat against its own limit"), "ratio_over_mass.png")
     done(tok)
 
     # --- summary.json ---------------------------------------------------------------
@@ -902,8 +1093,18 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
     timings["total"] = total
     facts = _design_facts(summaries, params.u_max)
     if exported != EXPORTED:
+        # the designs before it in the order of export, each with why it is not there
+        skipped = [n for n in (EXPORTED, ROBUST) if n != exported][
+            :(EXPORTED, ROBUST, "mu").index(exported)]
         facts += (f"controller.json holds the {_LONG_NAMES[exported]} design: "
-                  f"{_LONG_NAMES[EXPORTED]} failed ({errors.get(EXPORTED, 'not loaded')})",)
+                  + "; ".join(f"{_LONG_NAMES[n]} failed ({errors.get(n, 'not loaded')})"
+                              for n in skipped),)
+    if meta_export.get("stand_in"):
+        facts += (f"controller.json is a stand-in: {meta_export.get('description', '')}",)
+    if scheduled is not None and not scheduled[3].passed:
+        facts += (f"the scheduled controller's 1 kHz loop is {scheduled[3].gap:.2%} from the "
+                  f"continuous one at a scheduling value (tolerance "
+                  f"{scheduled[3].tolerance:.1%})",)
     over = [w for w in searched
             if not w.value <= {"u": params.u_max, "x1": params.z_max}[w.figure]]
     if over:
@@ -944,7 +1145,15 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
            for name, loaded in (("mu_constrained", constrained), ("mu_refined", refined),
                                 ("mu_occupants", occupants), ("mu_1khz", at_1khz))},
         "exported": exported,
+        "mu_scheduled": None if scheduled is None else {
+            "names": list(scheduled[0].names), "bounds": scheduled[0].bounds,
+            "nodes": list(schedule_nodes(scheduled[0])), "metadata": scheduled[1],
+            "check": scheduled[2], "sampled_1khz": dict(
+                dt=scheduled[3].dt, tolerance=scheduled[3].tolerance,
+                gap=scheduled[3].gap, passed=scheduled[3].passed,
+                nodes=[dataclasses.asdict(n) for n in scheduled[3].nodes])},
         "occupant_map": map_data,
+        "ratio_over_mass": ratio_data,
         "timings": timings,
         "facts": list(facts),
     }
@@ -959,21 +1168,111 @@ def reproduce(out_dir, *, progress: Callable[[str], None] | None = None,
                             timings=dict(timings), data=data, facts=facts)
 
 
-def _searched_worst(K, params, delays, cfg: _Settings, seed: int) -> tuple:
+def _searched_worst(K, params, delays, cfg: _Settings, seed: int, error: float = 0.0
+                    ) -> list:
     """The exported controller's largest commanded force and stroke over the set around
     the nominal seat (:class:`~lmi_suspension.seat.occupants.OccupantSet`), by search
-    (:func:`~lmi_suspension.seat.worstcase.worst_bump_seats`)."""
+    (:func:`~lmi_suspension.seat.worstcase.worst_bump_seats`), as ``[(WorstSeat,
+    scheduled_on)]``.
+
+    A scheduled controller is searched at each of its nodes (``scheduled_on``): the
+    controller there over the seats it may meet, the true mass within ``error`` of the
+    node's (:func:`~lmi_suspension.seat.scheduled.scheduling_subset`; every other
+    parameter over the whole set, also one it is scheduled on, which is conservative),
+    with the search's samples shared out between the nodes; the largest of each figure
+    over the nodes is kept.  One controller: ``scheduled_on`` is None."""
     from ..seat.occupants import OccupantSet
+    from ..seat.schedule_use import is_scheduled, schedule_nodes
+    from ..seat.scheduled import scheduling_subset
     from ..seat.worstcase import worst_bump_seats
 
-    return worst_bump_seats(K, OccupantSet(nominal=params), rng=np.random.default_rng(seed),
-                            n=cfg.search_n, starts=cfg.search_starts, delays=delays)
+    occupants = OccupantSet(nominal=params)
+    rng = np.random.default_rng(seed)
+    if not is_scheduled(K):
+        return [(w, None) for w in worst_bump_seats(
+            K, occupants, rng=rng, n=cfg.search_n, starts=cfg.search_starts, delays=delays)]
+    nodes = schedule_nodes(K)
+    lo, hi = occupants.m3
+    best: dict = {}
+    for p in nodes:
+        sub = (scheduling_subset(occupants, min(max(p["m3"], lo), hi), error)
+               if "m3" in p else occupants)
+        for w in worst_bump_seats(K.at(**p), sub, rng=rng, n=cfg.search_n // len(nodes),
+                                  starts=cfg.search_starts, delays=delays):
+            if w.figure not in best or w.value > best[w.figure][0].value:
+                best[w.figure] = (w, dict(p))
+    return list(best.values())
 
 
 def _searched_text(searched: Mapping) -> str:
     """The search's worst force and stroke (the summary's entries), in one phrase."""
-    return ("largest over the set by search: "
-            + "; ".join(f"{w['label']} {w['text']}" for w in searched.values()))
+    scheduled = any(w.get("scheduled_on") for w in searched.values())
+    return ("largest over the set by search"
+            + (" (the schedule at each node, over the seats whose mass it may be "
+               "estimated as)" if scheduled else "") + ": "
+            + "; ".join(f"{w['label']} {w['text']}"
+                        + (" (scheduled on " + ", ".join(
+                            f"{n} {v:g}" for n, v in w["scheduled_on"].items()) + ")"
+                           if w.get("scheduled_on") else "")
+                        for w in searched.values()))
+
+
+def _ratio_over_mass(Ks, K_robust, api, cfg: _Settings, params, errors: dict) -> tuple:
+    """The ratio-over-mass study: the schedule, the robust controller and the controllers
+    tuned for exactly one mass (``api.load_at_mass``, at their own masses), each seat
+    against its own limit (:func:`~lmi_suspension.seat.schedule_use.ratio_over_mass`,
+    the occupant map's delays, road and step).  Returns the summary's entry and the
+    curves."""
+    from ..seat import bump
+    from ..seat.schedule_use import ratio_over_mass, schedule_nodes
+
+    exported = f"{_LONG_NAMES[EXPORTED]} (controller.json)"
+    controllers = {exported: Ks}
+    if K_robust is not None:
+        controllers[f"{_LONG_NAMES[ROBUST]} (robust)"] = K_robust
+    at_mass = None
+    try:
+        at_mass, _meta = api.load_at_mass()
+        controllers[_PER_MASS] = at_mass
+    except (LmiSuspensionError, OSError, ValueError) as exc:
+        errors["mu_at_mass"] = f"{type(exc).__name__}: {exc}"
+    # the per-mass controllers' own masses too: the scheduled one is compared there
+    node_m3 = [] if at_mass is None else [p["m3"] for p in schedule_nodes(at_mass)]
+    masses = sorted(set(cfg.ratio_m3) | set(node_m3))
+    curves = ratio_over_mass(controllers, masses, delays=cfg.map_delays, params=params,
+                             road=bump(t_end=cfg.map_t_end, dt=1e-3), dt=cfg.map_step,
+                             limit_dt=cfg.limit_dt,
+                             at_nodes=(_PER_MASS,) if at_mass is not None else ())
+    by_label = {c.label: c for c in curves}
+    vs = []
+    if at_mass is not None:
+        sched = dict(zip(by_label[exported].m3, by_label[exported].ratio))
+        for m, r in zip(by_label[_PER_MASS].m3, by_label[_PER_MASS].ratio):
+            vs.append({"m3": m, "per_mass": r, "scheduled": sched[m],
+                       "scheduled_over_per_mass": sched[m] / r})
+    entry = {"m3": masses, "delays": list(cfg.map_delays), "step": cfg.map_step,
+             "curves": [dataclasses.asdict(c) for c in curves],
+             "scheduled_vs_per_mass": vs,
+             "within_1_2": bool(vs) and all(v["scheduled_over_per_mass"] <= 1.2 for v in vs),
+             "per_mass_error": errors.get("mu_at_mass")}
+    return entry, curves
+
+
+def _ratio_text(entry: Mapping | None) -> str:
+    """The ratio-over-mass study in one phrase."""
+    if not entry:
+        return "no ratio over the mass (the exported controller is not scheduled)"
+    parts = []
+    for c in entry["curves"]:
+        r = [x for x in c["ratio"] if x is not None]
+        parts.append(f"{c['label']} {_fmt(max(r), '.2f') if r else 'n/a'}")
+    text = ("peak / own limit along m3 (Table 1 otherwise), largest: " + "; ".join(parts))
+    for v in entry["scheduled_vs_per_mass"]:
+        text += (f"; at {v['m3']:g} kg the schedule is {_fmt(v['scheduled_over_per_mass'], '.2f')}"
+                 f" × the controller tuned for that mass")
+    if entry.get("per_mass_error"):
+        text += f" (no per-mass controllers: {entry['per_mass_error']})"
+    return text
 
 
 def _map_worst_text(worst: Mapping | None) -> str:
@@ -1106,14 +1405,34 @@ def comparison_table(summary: ReproduceSummary) -> str:
     grid = summary.data.get("occupant_map")
     if grid:
         exported = _LONG_NAMES.get(summary.data.get("exported"), "?")
+        runs = (", the schedule run at each seat's own values, no estimate error"
+                if summary.data.get("exported") == EXPORTED else "")
         lines.append(textwrap.fill(
             f"controller.json ({exported}) over occupant mass × seat spring "
-            f"({grid['cells']} cells, each seat's own limit): "
+            f"({grid['cells']} cells, each seat's own limit{runs}): "
             f"{grid['unstable_cells_in_set']} unstable in the set, {grid['unstable_cells']} "
             f"in the map; worst in the set {_map_worst_text(grid['worst_in_set'])}",
             width=len(head)))
+        for name, other in grid.get("compared", {}).items():
+            lines.append(textwrap.fill(
+                f"{_LONG_NAMES.get(name, name)} ({name}.json) on the same map: "
+                f"{other['unstable_cells_in_set']} unstable in the set; worst in the set "
+                f"{_map_worst_text(other['worst_in_set'])}", width=len(head)))
         if grid.get("searched"):
             lines.append(textwrap.fill(_searched_text(grid["searched"]), width=len(head)))
+    if summary.data.get("ratio_over_mass"):
+        lines.append(textwrap.fill(_ratio_text(summary.data["ratio_over_mass"]),
+                                   width=len(head)))
+    sched = summary.data.get("mu_scheduled")
+    if sched:
+        s1k = sched["sampled_1khz"]
+        lines.append(textwrap.fill(
+            f"{_LONG_NAMES[EXPORTED]}: its row is the schedule at the nominal seat's "
+            f"values; its 1 kHz loop (Tustin) on the bump is within "
+            f"{_fmt(s1k['gap'] * 100 if s1k['gap'] is not None else None, '.2f')} % of "
+            f"the continuous one at each of its {len(s1k['nodes'])} scheduling values "
+            f"(tolerance {s1k['tolerance'] * 100:g} %: "
+            f"{'met' if s1k['passed'] else 'NOT met'})", width=len(head)))
     # one screen: the facts wrapped to the table's width
     lines += [textwrap.fill(fact, width=len(head), initial_indent="- ",
                             subsequent_indent="  ") for fact in summary.facts]

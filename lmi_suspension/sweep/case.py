@@ -21,9 +21,10 @@ from ..seat import (
     simulate,
     white_noise,
 )
-from .spec import PASSIVE, PLANT_AXES, ROADS, Case, design_route
+from ..seat.schedule_use import controller_for_seat
+from .spec import PASSIVE, PLANT_AXES, ROADS, Case, design_route, schedule_errors
 
-__all__ = ["METRIC_COLUMNS", "compute_design", "compute_limit", "design_key", "error_row", "evaluate_batch",
+__all__ = ["METRIC_COLUMNS", "compute_design", "controller_from_saved", "compute_limit", "design_key", "error_row", "evaluate_batch",
            "evaluate_case", "limit_key"]
 
 #: the result columns of every row, after the case's index, controller and axis values
@@ -99,6 +100,17 @@ def compute_design(key: tuple, seed: int) -> dict:
                               metadata=d.metadata())
 
 
+def controller_from_saved(data: dict):
+    """The controller of a saved dict: a ``StateSpace``
+    (:func:`~lmi_suspension.io.controller_from_dict`) or, when its ``format`` says so, a
+    scheduled controller (:func:`~lmi_suspension.io.scheduled_from_dict`)."""
+    from ..io import SCHEDULED_FORMATS, controller_from_dict, scheduled_from_dict
+
+    if data.get("format") in SCHEDULED_FORMATS:
+        return scheduled_from_dict(data)
+    return controller_from_dict(data)
+
+
 def _blank_row(case: Case) -> dict:
     """A case's key and values, every result column empty."""
     return {"case": case.index, "controller": case.controller, **case.values,
@@ -112,11 +124,14 @@ def error_row(case: Case, message: str) -> dict:
 
 def evaluate_case(case: Case, K, road: str, settings: dict, limit: float | None) -> dict:
     """The row of one case (``K`` the controller, None for the passive seat;
-    ``settings`` the road's, with the simulation ``step``)."""
+    ``settings`` the road's, with the simulation ``step``).  A scheduled ``K`` runs at
+    the case's seat plus its estimate errors (the ``*_error`` axes,
+    :func:`~lmi_suspension.seat.schedule_use.controller_for_seat`)."""
     t0 = time.perf_counter()
     row = _blank_row(case)
     try:
         p = _params(case.values)
+        K = controller_for_seat(K, p, schedule_errors(case.values))
         delay = float(case.values.get("delay", 0.0))
         r = _road(road, settings, case.values, case.rng())
         res = simulate(K, r, delay=delay, params=p, dt=settings["step"])
@@ -145,13 +160,11 @@ def evaluate_batch(cases: list, controllers: dict, road: str, settings: dict,
     """Rows of a batch of cases.  ``controllers`` maps each controller entry to its saved
     dict (rebuilt exactly here, on the worker); ``limits`` maps limit keys to peaks and
     ``designs`` design keys to saved dicts (:func:`compute_design`)."""
-    from ..io import controller_from_dict
-
-    built = {name: controller_from_dict(d) for name, d in controllers.items()
+    built = {name: controller_from_saved(d) for name, d in controllers.items()
              if name != PASSIVE and design_route(name) is None}
     built[PASSIVE] = None
     for key, d in (designs or {}).items():
-        built[key] = d if "error" in d else controller_from_dict(d)
+        built[key] = d if "error" in d else controller_from_saved(d)
     rows = []
     for case in cases:
         key = limit_key(case, road, settings)

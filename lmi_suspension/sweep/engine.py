@@ -106,7 +106,7 @@ def _versions() -> dict:
 def _load_controllers(spec: SweepSpec) -> dict:
     """Every controller of the spec as its saved dict (read and checked now, in the client,
     so a bad file is an error before any case runs)."""
-    from ..io import controller_from_dict
+    from .case import controller_from_saved
 
     out = {}
     for name in spec.controllers:
@@ -118,7 +118,7 @@ def _load_controllers(spec: SweepSpec) -> dict:
             raise InputError(f"controllers: file {path} not found")
         try:
             text = json.loads(path.read_text())
-            controller_from_dict(text)
+            controller_from_saved(text)
         except (OSError, UnicodeDecodeError) as exc:
             raise InputError(f"controllers: cannot read {path}: {exc}") from exc
         except (LmiSuspensionError, ValueError, KeyError, TypeError, IndexError) as exc:

@@ -12,7 +12,14 @@ Axes (names of a grid axis or of a Monte-Carlo range):
   ``m3``, ``c1`` … ``k3``, ``z_max``, ``u_max``);
 * ``delay``: the actuator delay, s (rounded to the simulation step, 0.1 ms by default);
 * the road's parameters: ``height`` (m), ``length`` (m) and ``speed_kmh`` of the bump;
-  ``speed_kmh`` of the ISO 8608 road; ``psd`` ((m/s)²/Hz) of the white floor velocity.
+  ``speed_kmh`` of the ISO 8608 road; ``psd`` ((m/s)²/Hz) of the white floor velocity;
+* ``<parameter>_error`` (``m3_error``, ``k1_error``, ...): the error of the seat's
+  estimate of a parameter a *scheduled* controller (``seat/data/mu_scheduled.json``) is
+  scheduled on, in that parameter's unit.  A scheduled controller runs at the case's
+  values plus these errors
+  (:func:`~lmi_suspension.seat.schedule_use.controller_for_seat`: held inside its
+  schedule's range); an unscheduled controller, and a schedule not on that parameter,
+  measure nothing and ignore them.
 
 Monte-Carlo values are drawn uniformly, each case from its own generator (``sampling =
 "uniform"``), or as one Latin hypercube shared by every controller and grid point
@@ -33,12 +40,29 @@ import numpy as np
 from ..errors import InputError, ParameterError
 from ..seat.params import SeatParameters
 
-__all__ = ["DESIGN", "design_route", "PASSIVE", "PLANT_AXES", "ROADS", "SAMPLINGS", "Case",
-           "SweepSpec", "parse_range"]
+__all__ = ["DESIGN", "design_route", "ERROR_AXES", "PASSIVE", "PLANT_AXES", "ROADS",
+           "SAMPLINGS", "Case", "SweepSpec", "parse_range", "schedule_errors"]
 
 #: the seat's parameters a sweep may vary (the delay bounds of SeatParameters are the
 #: design's, not a case's: a case has one delay)
 PLANT_AXES = tuple(f.name for f in fields(SeatParameters) if not f.name.startswith("delay_"))
+#: the errors of a scheduled controller's estimates: ``m3_error`` is the seat's estimate
+#: of ``m3`` minus the true ``m3`` (kg), likewise for every seat parameter
+ERROR_AXES = tuple(f"{n}_error" for n in PLANT_AXES)
+
+
+def schedule_errors(values: dict) -> dict:
+    """The estimate errors of a case's values, by parameter (``{"m3": -5.0}`` for
+    ``m3_error = -5``).
+
+    Examples
+    --------
+    >>> schedule_errors({"m3": 50.0, "m3_error": -5.0, "delay": 0.0})
+    {'m3': -5.0}
+    """
+    return {n[:-len("_error")]: float(v) for n, v in values.items() if n in ERROR_AXES}
+
+
 #: each road and the parameters it takes (all numeric; ``road_class`` is a fixed option)
 ROADS = {
     "bump": ("height", "length", "speed_kmh"),
@@ -168,7 +192,9 @@ class SweepSpec:
     Attributes
     ----------
     controllers : tuple of str
-        Saved controller files (:func:`~lmi_suspension.io.save_controller`),
+        Saved controller files (:func:`~lmi_suspension.io.save_controller`, or a
+        scheduled controller's, :func:`~lmi_suspension.io.save_scheduled_controller`:
+        run at each case's values, see the ``*_error`` axes),
         ``"passive"`` (no controller), ``"design"``: a µ controller synthesised for the
         case's own seat (the µ route of :func:`~lmi_suspension.seat.routes.design_seat`,
         the paper's weights and uncertainty; about 2 s each, once per distinct seat), or
@@ -296,7 +322,7 @@ class SweepSpec:
             self._check_value(name, hi)
 
     def axes_known(self) -> tuple:
-        return PLANT_AXES + ("delay",) + ROADS[self.road]
+        return PLANT_AXES + ("delay",) + ROADS[self.road] + ERROR_AXES
 
     def _check_axis(self, name, known, seen):
         if name not in known:
@@ -308,6 +334,8 @@ class SweepSpec:
 
     @staticmethod
     def _check_value(name, v):
+        if name in ERROR_AXES:
+            return                      # an estimate's error has either sign
         if name == "delay":
             if v < 0:
                 raise ParameterError(f"delay: {v} s is negative")
