@@ -1175,9 +1175,9 @@ def _searched_worst(K, params, delays, cfg: _Settings, seed: int, error: float =
     (:func:`~lmi_suspension.seat.worstcase.worst_bump_seats`), as ``[(WorstSeat,
     scheduled_on)]``.
 
-    A scheduled controller is searched at each of its nodes (``scheduled_on``): the
-    controller there over the seats it may meet, the true mass within ``error`` of the
-    node's (:func:`~lmi_suspension.seat.scheduled.scheduling_subset`; every other
+    A scheduled controller is searched at each of its nodes (``scheduled_on``; a table
+    of bins at each bin's centre): the controller there over the seats it may meet, the
+    true mass within ``error`` of the node's (of the bin's ends) (:func:`~lmi_suspension.seat.scheduled.scheduling_subset`; every other
     parameter over the whole set, also one it is scheduled on, which is conservative),
     with the search's samples shared out between the nodes; the largest of each figure
     over the nodes is kept.  One controller: ``scheduled_on`` is None."""
@@ -1193,10 +1193,17 @@ def _searched_worst(K, params, delays, cfg: _Settings, seed: int, error: float =
             K, occupants, rng=rng, n=cfg.search_n, starts=cfg.search_starts, delays=delays)]
     nodes = schedule_nodes(K)
     lo, hi = occupants.m3
+    # a table of bins runs one controller over its whole bin of estimates: search the
+    # seats of the bin widened by the error, not of its centre alone
+    bins = K.bins if getattr(K, "interpolation", None) == "bins" else None
     best: dict = {}
-    for p in nodes:
-        sub = (scheduling_subset(occupants, min(max(p["m3"], lo), hi), error)
-               if "m3" in p else occupants)
+    for i, p in enumerate(nodes):
+        if "m3" not in p:
+            sub = occupants
+        elif bins is not None:
+            sub = scheduling_subset(occupants, bins[i][K.names.index("m3")], error)
+        else:
+            sub = scheduling_subset(occupants, min(max(p["m3"], lo), hi), error)
         for w in worst_bump_seats(K.at(**p), sub, rng=rng, n=cfg.search_n // len(nodes),
                                   starts=cfg.search_starts, delays=delays):
             if w.figure not in best or w.value > best[w.figure][0].value:
