@@ -8,6 +8,7 @@ the time-stepping simulation and the limit LP for the frequency-domain road figu
 ``mussv`` on the closed loop built by python-control for the mixed µ.
 """
 
+from dataclasses import replace
 from pathlib import Path
 
 import control
@@ -23,7 +24,12 @@ from lmi_suspension.seat.limit import bump_limit
 from lmi_suspension.seat.augmented import DEFAULT_DESIGN
 from lmi_suspension.seat.occupants import (MixedRsBound, OccupantSamples, OccupantSet,
                                            certify_occupants, occupant_mu, occupant_samples)
+from lmi_suspension.seat.occupant_subset import OccupantSubset
 from lmi_suspension.seat.params import SeatParameters
+from lmi_suspension.seat.scheduled import scheduling_subset
+from lmi_suspension.seat.uncertainty import close_upper, parametric_uncertainty
+from lmi_suspension.seat import seat_model
+from lmi_suspension.umodel.blocks import BlockStructure
 from lmi_suspension.seat.loop import TwoBlockMu, loop_poles
 from lmi_suspension.seat.refine import load_refined
 from lmi_suspension.seat.roads import bump
@@ -88,7 +94,8 @@ def test_corners_are_every_combination_of_the_ends():
 @pytest.mark.parametrize("kwargs", [dict(m3=(70.0, 30.0)), dict(m3=(0.0, 10.0)),
                                     dict(stiffness_rel=1.0), dict(damping_rel=-0.1),
                                     dict(delay=(-0.01, 0.02)), dict(delay=(0.0, np.nan)),
-                                    dict(nominal="Table 1")])
+                                    dict(nominal="Table 1"), dict(k1_rel=1.0),
+                                    dict(k1_rel=-0.05), dict(k1_rel=True)])
 def test_bad_sets_raise(kwargs):
     with pytest.raises(ParameterError):
         OccupantSet(**kwargs)
@@ -104,6 +111,87 @@ def test_bad_sampling_raises(n, rng, method):
 def test_corners_of_an_unknown_parameter_raise():
     with pytest.raises(ParameterError, match="m1"):
         OccupantSet().corners(("m1",))
+
+
+# ------------------------------------------------------------- a k1 range of its own (issue 62)
+
+def _bin45(**kw):
+    """The scheduling pilot's bin: true m3 35-55 kg, the seat at 45 kg."""
+    return OccupantSubset(nominal=replace(SeatParameters(), m3=45.0), m3=(35.0, 55.0), **kw)
+
+
+def test_a_k1_range_of_its_own_narrows_k1_alone_in_ranges_samples_and_corners():
+    """``k1_rel`` (a seat that estimates its spring from the static deflection) replaces
+    ``stiffness_rel`` for k1 only.  Sampled with the same generator, the Latin hypercube
+    draws the same unit points, so every sample is the wide set's with k1 mapped
+    linearly from (1 ± 0.2) k1_nom onto (1 ± 0.1) k1_nom."""
+    k1 = SeatParameters().k1
+    narrow, wide = _bin45(k1_rel=0.1), _bin45()
+    r, rw = dict((n, (lo, hi)) for n, lo, hi in narrow.ranges()), \
+        dict((n, (lo, hi)) for n, lo, hi in wide.ranges())
+    assert r["k1"] == pytest.approx((0.9 * k1, 1.1 * k1), rel=1e-15)
+    assert {n: v for n, v in r.items() if n != "k1"} == {n: v for n, v in rw.items() if n != "k1"}
+    n = 40
+    seats, delays = narrow.sample(n, np.random.default_rng(62))
+    seats_w, delays_w = wide.sample(n, np.random.default_rng(62))
+    assert np.array_equal(delays, delays_w)
+    got = np.array([p.k1 for p in seats])
+    np.testing.assert_allclose(got, k1 + 0.5 * (np.array([p.k1 for p in seats_w]) - k1),
+                               rtol=1e-12)
+    assert sorted(np.floor((got - 0.9 * k1) / (0.2 * k1) * n).astype(int)) == list(range(n))
+    assert [replace(p, k1=k1) for p in seats] == [replace(p, k1=k1) for p in seats_w]
+    assert sorted({p.k1 for p in narrow.corners(("m3", "k1"))}) == \
+        pytest.approx([0.9 * k1, 1.1 * k1], rel=1e-15)
+    # a schedule's subsets keep the set's k1 range
+    assert scheduling_subset(OccupantSet(k1_rel=0.1), (40.0, 50.0), 5.0).ranges() == \
+        narrow.ranges()
+
+
+def test_the_mu_models_k1_scalar_spans_the_sampled_k1_range():
+    """The µ model of a set with ``k1_rel`` has its k1 real scalar over the narrower
+    range: its LFT closed at δ = ±1 is the seat model (built directly from the
+    parameters) at the ends of the sampled k1 range; in the augmented plant that the
+    robust-stability bound uses, k1's scalar at δ is the wide set's at δ / 2.  ``k1_rel = 0`` leaves k1 out of the structure."""
+    narrow, wide = _bin45(k1_rel=0.1), _bin45()
+    o = narrow.mu_design()
+    assert o.stiffness == ("k1", "k2", "k3") and o.k1_rel == 0.1
+    pu = parametric_uncertainty(narrow.nominal, o.m3_range, o.stiffness_rel,
+                                stiffness=o.stiffness, damping=o.damping,
+                                damping_rel=o.damping_rel, k1_rel=o.k1_rel)
+    seats, _ = narrow.sample(40, np.random.default_rng(62))
+    k1s = [p.k1 for p in seats]
+    k1_ends = dict((n, (lo, hi)) for n, lo, hi in narrow.ranges())["k1"]
+    assert k1_ends[0] <= min(k1s) and max(k1s) <= k1_ends[1]
+    w = np.logspace(-1, 4, 40)
+    for d_m3, m3 in ((1.0, 35.0), (-1.0, 55.0)):
+        for d_k1, k1 in ((-1.0, k1_ends[0]), (1.0, k1_ends[1])):
+            d = [d_m3 if n == "m3" else d_k1 if n == "k1" else 0.0 for n in pu.names]
+            ref = seat_model(replace(narrow.nominal, m3=m3, k1=k1))
+            r1, r2 = pu.model_at(d)(1j * w), ref(1j * w)
+            np.testing.assert_allclose(r1, r2, rtol=1e-9, atol=1e-9 * np.abs(r2).max())
+    aug = seat_augmented_plant(o, narrow.nominal)
+    aug_w = seat_augmented_plant(wide.mu_design(), wide.nominal)
+    assert aug.block_names == aug_w.block_names
+    # every uncertain channel closed, all at zero but k1's: the plant of the robust-
+    # stability bound with k1 at δ of its range (the channels' balancing drops out)
+    struct = BlockStructure.coerce(np.asarray(aug.blk)[:-1])
+    k = aug.block_names.index("k1")
+
+    def closed(a, d):
+        Delta = np.zeros(struct.shape_M[::-1])
+        Delta[struct.col_slices()[k], struct.row_slices()[k]] = d
+        return freqresp(close_upper(a.P, Delta), w)
+
+    for d in (-1.0, 1.0):
+        narrow_d, wide_half = closed(aug, d), closed(aug_w, d / 2)
+        np.testing.assert_allclose(narrow_d, wide_half, rtol=1e-8,
+                                   atol=1e-10 * np.abs(wide_half).max())
+        assert not np.allclose(narrow_d, closed(aug_w, d), rtol=1e-3)
+    assert _bin45(k1_rel=0.0).mu_design().stiffness == ("k2", "k3")
+    with pytest.raises(ParameterError):
+        parametric_uncertainty(k1_rel=1.5)
+    with pytest.raises(ParameterError):
+        replace(DEFAULT_DESIGN, k1_rel=-0.1)
 
 
 # ----------------------------------------------------------------------------- certificate

@@ -92,6 +92,9 @@ class SeatDesignOptions:
         Occupant mass range, kg (``None``: m3 fixed).
     stiffness, stiffness_rel, damping, damping_rel
         Uncertain springs/dampers and their relative ranges.
+    k1_rel : float, optional
+        The seat spring's own relative range in place of ``stiffness_rel`` (see
+        :func:`~.uncertainty.parametric_uncertainty`); ``None`` takes ``stiffness_rel``.
     parametric_complex : bool
         Give the parametric scalars complex ``[1, 1]`` rows in ``blk`` (a cover of the
         real ones) instead of real ``[-1, 0]`` rows.
@@ -133,6 +136,7 @@ class SeatDesignOptions:
     stiffness_rel: float = 0.2
     damping: tuple[str, ...] = ()
     damping_rel: float = 0.2
+    k1_rel: float | None = None
     parametric_complex: bool = False
     paper_delta: float = 0.02
     paper_input_uncertainty: bool = True
@@ -189,6 +193,7 @@ class SeatDesignOptions:
                 raise ParameterError(f"m3_range must be increasing, got {self.m3_range}")
         num("stiffness_rel", self.stiffness_rel)
         num("damping_rel", self.damping_rel)
+        num("k1_rel", self.k1_rel, allow_none=True)
         object.__setattr__(self, "stiffness", tuple(self.stiffness))
         object.__setattr__(self, "damping", tuple(self.damping))
 
@@ -350,7 +355,7 @@ def _core(params: SeatParameters, opts: SeatDesignOptions):
     if opts.include_parametric:
         pu = parametric_uncertainty(params, opts.m3_range, opts.stiffness_rel,
                                     stiffness=opts.stiffness, damping=opts.damping,
-                                    damping_rel=opts.damping_rel)
+                                    damping_rel=opts.damping_rel, k1_rel=opts.k1_rel)
         G = pu.G
         nominal = pu.nominal
         npar = len(pu.names)

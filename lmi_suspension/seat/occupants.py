@@ -91,6 +91,11 @@ class OccupantSet:
         ``(1 ± damping_rel)``; in [0, 1).
     delay : (float, float)
         Actuator delay, s.
+    k1_rel : float, optional
+        ``k1`` within ``(1 ± k1_rel)`` of nominal instead of ``stiffness_rel``, in
+        [0, 1): a seat that estimates its spring from the static deflection under the
+        measured load knows ``k1`` better than the body's springs.  ``None`` (default)
+        takes ``stiffness_rel``.
     """
 
     nominal: SeatParameters = field(default_factory=SeatParameters)
@@ -98,6 +103,7 @@ class OccupantSet:
     stiffness_rel: float = 0.2
     damping_rel: float = 0.2
     delay: tuple = (0.0, 0.025)
+    k1_rel: float | None = None
 
     def __post_init__(self):
         if not isinstance(self.nominal, SeatParameters):
@@ -105,16 +111,24 @@ class OccupantSet:
                                  f"{type(self.nominal).__name__}")
         object.__setattr__(self, "m3", _interval(self.m3, "m3", positive=True))
         object.__setattr__(self, "delay", _interval(self.delay, "delay", positive=False))
-        for name in ("stiffness_rel", "damping_rel"):
+        for name in ("stiffness_rel", "damping_rel", "k1_rel"):
             v = getattr(self, name)
+            if name == "k1_rel" and v is None:
+                continue
             if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 <= v < 1:
                 raise ParameterError(f"{name} must lie in [0, 1), got {v!r}")
+
+    def _rel(self, name: str) -> float:
+        """The relative range of the spring or damper ``name``."""
+        if name == "k1" and self.k1_rel is not None:
+            return self.k1_rel
+        return self.stiffness_rel if name.startswith("k") else self.damping_rel
 
     def ranges(self) -> tuple:
         """``(name, lo, hi)`` of every uncertain parameter: ``m3``, ``k1..k3``, ``c1..c3``."""
         out = [("m3",) + tuple(self.m3)]
         for name in _ELEMENTS:
-            rel = self.stiffness_rel if name.startswith("k") else self.damping_rel
+            rel = self._rel(name)
             nom = getattr(self.nominal, name)
             out.append((name, nom * (1 - rel), nom * (1 + rel)))
         return tuple(out)
@@ -171,10 +185,12 @@ class OccupantSet:
 
         design = DEFAULT_DESIGN if design is None else design
         damping = _ELEMENTS[3:] if self.damping_rel > 0 else ()
-        stiffness = _ELEMENTS[:3] if self.stiffness_rel > 0 else ()
+        stiffness = tuple(n for n in _ELEMENTS[:3] if self._rel(n) > 0)
+        # a k1 range of its own reaches the µ model's k1 scalar (None: stiffness_rel's)
+        k1_rel = self.k1_rel if self.k1_rel is not None and self.k1_rel > 0 else None
         return replace(design, include_parametric=True, parametric_complex=False,
                        m3_range=tuple(self.m3), stiffness=stiffness,
-                       stiffness_rel=self.stiffness_rel or design.stiffness_rel,
+                       stiffness_rel=self.stiffness_rel or design.stiffness_rel, k1_rel=k1_rel,
                        damping=damping, damping_rel=self.damping_rel or design.damping_rel,
                        delay_min=self.delay[0], delay_max=self.delay[1])
 
@@ -477,7 +493,7 @@ def _lower_bound_seat(aug, rs) -> tuple[SeatParameters | None, float]:
              in zip(aug.block_names, struct.col_slices(), struct.row_slices())}
     o = aug.options
     pu = parametric_uncertainty(aug.params, o.m3_range, o.stiffness_rel, stiffness=o.stiffness,
-                                damping=o.damping, damping_rel=o.damping_rel)
+                                damping=o.damping, damping_rel=o.damping_rel, k1_rel=o.k1_rel)
     scale = min(1.0, float(lower[k]))
     d = [float(np.clip(delta[name] * scale, -1.0, 1.0)) for name in pu.names]
     omega = rs.omega[k] if rs.omega is not None else math.nan

@@ -115,7 +115,7 @@ def scheduling_subset(occupants: OccupantSet, m3_hat, error: float) -> OccupantS
                           m3=(max(lo, a - e), min(hi, b + e)),
                           stiffness_rel=occupants.stiffness_rel,
                           damping_rel=occupants.damping_rel, delay=occupants.delay,
-                          fixed=fixed)
+                          k1_rel=occupants.k1_rel, fixed=fixed)
 
 
 def _mass_range(Ks) -> tuple[float, float]:

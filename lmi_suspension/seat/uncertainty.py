@@ -469,7 +469,8 @@ def parametric_uncertainty(params: SeatParameters | None = None,
                            stiffness_rel: float = 0.2, *,
                            stiffness: tuple[str, ...] = ("k1",),
                            damping: tuple[str, ...] = (),
-                           damping_rel: float = 0.2) -> ParametricUncertainty:
+                           damping_rel: float = 0.2,
+                           k1_rel: float | None = None) -> ParametricUncertainty:
     """Occupant mass and spring/damper uncertainty as real scalars ``δ ∈ [-1, 1]`` (LFT).
 
     The model is written with element forces ``F1 = k1 x1 + c1 (x2 - w)``,
@@ -493,6 +494,10 @@ def parametric_uncertainty(params: SeatParameters | None = None,
         The uncertain springs.
     damping, damping_rel
         The same for dampers ``"c1"``, ``"c2"``, ``"c3"``.
+    k1_rel : float, optional
+        The seat spring's own relative range, in (0, 1), in place of ``stiffness_rel``
+        (a seat that estimates ``k1`` from its static deflection knows it better than
+        the body's springs); ``None`` takes ``stiffness_rel``.
 
     Returns
     -------
@@ -512,7 +517,10 @@ def parametric_uncertainty(params: SeatParameters | None = None,
         raise TypeError(f"params must be a SeatParameters, got {type(params).__name__}")
     stiffness_rel = _real(stiffness_rel, "stiffness_rel")
     damping_rel = _real(damping_rel, "damping_rel")
-    for label, rel, sel in (("stiffness_rel", stiffness_rel, stiffness),
+    k1_rel = stiffness_rel if k1_rel is None else _real(k1_rel, "k1_rel")
+    for label, rel, sel in (("stiffness_rel", stiffness_rel,
+                             tuple(n for n in stiffness if n != "k1")),
+                            ("k1_rel", k1_rel, tuple(n for n in stiffness if n == "k1")),
                             ("damping_rel", damping_rel, damping)):
         if sel and not 0 < rel < 1:
             raise ParameterError(f"{label} must lie in (0, 1), got {rel}")
@@ -540,7 +548,7 @@ def parametric_uncertainty(params: SeatParameters | None = None,
     for name in _ELEMENTS:
         if name in stiffness:
             names.append(name)
-            rel.append(stiffness_rel)
+            rel.append(k1_rel if name == "k1" else stiffness_rel)
         elif name in damping:
             names.append(name)
             rel.append(damping_rel)
