@@ -537,7 +537,7 @@ def plot_occupant_maps(panels: Sequence[Mapping], *, box=None, title: str = "") 
     finite = np.concatenate([v[np.isfinite(v)] for v in shown])
     norm = Normalize(vmin=float(finite.min()) if finite.size else 0.0,
                      vmax=float(np.percentile(finite, 98)) if finite.size else 1.0)
-    fig = Figure(figsize=(5.6 * len(panels) + 1.0, 4.8), layout="constrained")
+    fig = Figure(figsize=(5.6 * len(panels) + 1.0, 5.3), layout="constrained")
     axes = fig.subplots(1, len(panels), sharey=True, squeeze=False)[0]
     mesh = None
     for ax, p, z in zip(axes, panels, shown):
@@ -569,7 +569,9 @@ def plot_occupant_maps(panels: Sequence[Mapping], *, box=None, title: str = "") 
                                 fontsize=7, color="w" if norm(z[i, j]) < 0.6 else "k")
         ax.set_title(p["title"], fontsize=10)
         ax.set_xlabel("upper-body mass m3 [kg]")
-        ax.legend(loc="upper left", fontsize=7)
+        # below the panel: inside it would hide the numbers of its corner cells
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=7, ncol=2,
+                  frameon=False)
     axes[0].set_ylabel("seat spring k1 [N/m]")
     fig.colorbar(mesh, ax=list(axes), label="worst peak |z3''| / own limit (stable cells)")
     if title:
