@@ -530,6 +530,8 @@ def plot_occupant_maps(panels: Sequence[Mapping], *, box=None, title: str = "") 
     from matplotlib.colors import Normalize
     from matplotlib.patches import Rectangle
 
+    from ..sweep.plots import draw_unstable
+
     if not panels:
         raise ValueError("no panels to draw")
     shown = [np.where(np.asarray(p["stable"], bool), np.asarray(p["ratio"], float), np.nan)
@@ -544,13 +546,7 @@ def plot_occupant_maps(panels: Sequence[Mapping], *, box=None, title: str = "") 
         xs, ys = np.asarray(p["m3"], float), np.asarray(p["k1"], float)
         stable = np.asarray(p["stable"], bool)
         mesh = ax.pcolormesh(xs, ys, z, shading="nearest", cmap="viridis", norm=norm)
-        if not stable.all():
-            ax.pcolor(xs, ys, np.where(stable, np.nan, 1.0), shading="nearest", hatch="//",
-                      cmap="Greys", vmin=0, vmax=3, alpha=0.6)
-            if stable.any():
-                ax.contour(xs, ys, stable.astype(float), levels=[0.5], colors="red",
-                           linewidths=2.0)
-            ax.plot([], [], color="red", lw=2, label="stability boundary (hatched: unstable)")
+        draw_unstable(ax, xs, ys, stable)
         if box is not None:
             (m_lo, m_hi), (k_lo, k_hi) = box
             ax.add_patch(Rectangle((m_lo, k_lo), m_hi - m_lo, k_hi - k_lo, fill=False,

@@ -9,7 +9,7 @@ import numpy as np
 
 from .spec import SweepSpec
 
-__all__ = ["plot_map", "plot_tradeoff", "write_figures"]
+__all__ = ["draw_unstable", "plot_map", "plot_tradeoff", "write_figures"]
 
 _LABELS = {"m3": "upper-body mass m3 [kg]", "delay": "actuator delay [ms]",
            "k1": "seat spring k1 [N/m]", "speed_kmh": "speed [km/h]",
@@ -27,6 +27,24 @@ def _label(name: str) -> str:
 def _columns(table) -> dict:
     return {name: table.column(name).to_numpy(zero_copy_only=False)
             for name in table.column_names}
+
+
+def draw_unstable(ax, xs, ys, stable) -> bool:
+    """Hatch a map's unstable cells and draw the stability boundary in red (with its
+    legend entry); returns whether any cell is unstable.
+
+    ``stable`` is a ``len(ys) × len(xs)`` boolean array over the cells centred at
+    ``xs``, ``ys``.
+    """
+    stable = np.asarray(stable, bool)
+    if stable.all():
+        return False
+    ax.pcolor(xs, ys, np.where(stable, np.nan, 1.0), shading="nearest", hatch="//",
+              cmap="Greys", vmin=0, vmax=3, alpha=0.6)
+    if stable.any():
+        ax.contour(xs, ys, stable.astype(float), levels=[0.5], colors="red", linewidths=2.0)
+    ax.plot([], [], color="red", lw=2, label="stability boundary (hatched: unstable)")
+    return True
 
 
 def plot_map(table, spec: SweepSpec, controller: str, value: str | None = None):
@@ -69,13 +87,7 @@ def plot_map(table, spec: SweepSpec, controller: str, value: str | None = None):
     mesh = ax.pcolormesh(xs, ys, shown, shading="nearest", cmap="viridis",
                          vmin=np.nanmin(finite) if finite.size else 0.0, vmax=vmax)
     fig.colorbar(mesh, ax=ax, label=_label(value) + " (stable cases)")
-    if not stable.all():
-        ax.pcolor(xs, ys, np.where(stable, np.nan, 1.0), shading="nearest", hatch="//",
-                  cmap="Greys", vmin=0, vmax=3, alpha=0.6)
-        if stable.any():
-            ax.contour(xs, ys, stable.astype(float), levels=[0.5], colors="red",
-                       linewidths=2.0)
-        ax.plot([], [], color="red", lw=2, label="stability boundary (hatched: unstable)")
+    if draw_unstable(ax, xs, ys, stable):
         ax.legend(loc="upper left", fontsize=8)
     ax.set_xlabel(_label(xn))
     ax.set_ylabel(_label(yn))
