@@ -1,11 +1,16 @@
-"""Mixed µ-synthesis on the two-mass plant and the stiffness oscillator (issue 64, items
-2 and 3): µ upper and lower bound, controller order, seconds, peak memory, stop reason.
+"""Mixed µ-synthesis on the two-mass plant, the stiffness oscillator and the seat over m3
+and k1 (issue 64, items 2 and 3): µ upper and lower bound, controller order, seconds,
+peak memory, stop reason.
 
 ``python benchmarks/musyn_mixed.py two_mass complexify=True`` -- the first argument
 the problem (``two_mass``: :func:`~lmi_suspension.examples.uncertain_two_mass`,
 ``musyn(P, 1, 1)`` on the default grid; ``oscillator``:
 :func:`~lmi_suspension.examples.stiffness_oscillator` on ``bench_dgk.py``'s 40-point
-grid without the D-scale search), the others ``MusynOptions`` keywords.  Run it under
+grid without the D-scale search; ``seat``: the seat over m3 and k1 of
+``bench_dgk.py``, ``seat_augmented_plant(SeatDesignOptions(include_paper=False))`` on
+``DEFAULT_OMEGA`` with ``replace(DEFAULT_MUSYN, max_iter=6, patience=2)``: ``seat`` and
+``seat complexify=True``), the others ``MusynOptions`` keywords (for ``seat``, these
+two included).  Run it under
 ``ulimit -v 4000000`` and ``timeout``: D-G-K with 10 G poles on the two-mass plant
 (``complex_candidate=None, max_gfit_poles=10``) filled a 4 GB address space at its
 second K-step (2026-12-02).
@@ -13,6 +18,7 @@ second K-step (2026-12-02).
 
 import ast
 import logging
+from dataclasses import replace
 import os
 import resource
 import sys
@@ -37,6 +43,13 @@ if __name__ == "__main__":
         ex = stiffness_oscillator()
         res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-2, 1.5, 40),
                     options=MusynOptions(max_iter=8, dscale_search=0, **kw))
+    elif problem == "seat":
+        from lmi_suspension.seat.augmented import SeatDesignOptions, seat_augmented_plant
+        from lmi_suspension.seat.design import DEFAULT_MUSYN, DEFAULT_OMEGA
+
+        aug = seat_augmented_plant(SeatDesignOptions(include_paper=False))
+        res = musyn(aug.P, aug.nmeas, aug.ncon, aug.blk, omega=DEFAULT_OMEGA,
+                    options=replace(DEFAULT_MUSYN, **{"max_iter": 6, "patience": 2, **kw}))
     else:
         res = musyn(uncertain_two_mass(), 1, 1, options=MusynOptions(**kw))
     seconds = time.perf_counter() - t0
@@ -48,6 +61,10 @@ if __name__ == "__main__":
           f"{res.best_iteration}, "
           f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB")
     print("stop:", res.stop_reason)
+    print(f"all-frequency bound {res.mu_bound:.4f}; closed loop's largest pole real part "
+          f"{np.max(np.real(np.linalg.eigvals(np.asarray(res.CL.A)))):.3g}")
+    if res.reduced_from is not None:
+        print(f"reduced from {res.reduced_from} states (full-order µ {res.mu_peak_full:.4f})")
     if res.complex_run is not None:
         print(f"complexified run: {res.complex_run.seconds:.1f} s (wall), complex µ per iterate "
               f"{[round(h.mu_peak, 4) for h in res.complex_run.history]}, its mixed µ "
