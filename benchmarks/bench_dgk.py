@@ -42,7 +42,10 @@ def test_bench_dgk_seat_m3_k1(benchmark, complexify):
     beside the delay block and the performance block (``include_paper=False``), with the
     paper design's D-K options (constant D-scales, ``method="best"``) run longer.
     2026-11-27 (one thread): complex D-K 2.671 in 165 s (K order 13), D-G-K 2.734 in
-    479 s (K order 73): µ there is set by the delay and performance blocks."""
+    479 s (K order 73): µ there is set by the delay and performance blocks.
+    2026-12-02 (cpu family 25, ``python benchmarks/musyn_mixed.py seat``): complex 2.6711
+    in 4 s CPU; default D-G-K returns that controller (its own best 2.7407) in 15-18 s;
+    ``complex_candidate="start"`` 2.6646 (31 states) in 11-12 s."""
     from dataclasses import replace
 
     from lmi_suspension.seat.augmented import SeatDesignOptions, seat_augmented_plant

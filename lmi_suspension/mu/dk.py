@@ -269,7 +269,8 @@ class MusynOptions:
         :attr:`MusynResult.complex_run` holds that run (its records do not go to
         ``callback``).  ``None``: D-G-K alone, which
         can end above complex D-K (the seat over m3 and k1: 2.734 against 2.671,
-        2026-11-27; the two-mass plant weighted 1 and 1, with 10 G poles: 2.7340 against
+        2026-11-27; 2.7407 against 2.6711 on 2026-12-02, where ``"start"`` reaches
+        2.6646 with 31 states; the two-mass plant weighted 1 and 1, with 10 G poles: 2.7340 against
         2.6355, its second K-step failing, 2026-12-02).  With ``K0``, the complexified run starts
         from it.
     max_gfit_poles : int or None
