@@ -255,7 +255,9 @@ def search_dscales(P, nmeas: int, ncon: int, block_sizes, omega, d_blocks, weigh
     ...                        np.ones(w.size), 2, level, controller, max_evals=40)
     >>> found.evaluations <= 40 and found.level < found.level_start < mu.peak
     True
-    >>> bool(found.gamma <= 1.01 * found.level * (1 + 1e-6))
+    >>> # SLICOT's controller at a fixed γ certifies within roundoff of it: 3.2e-5 above
+    >>> # under OpenBLAS Sandybridge, 9e-5 below under SkylakeX (2026-12-02)
+    >>> bool(found.gamma <= 1.01 * found.level * (1 + 1e-4))
     True
     """
     t0 = time.perf_counter()
