@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from lmi_suspension.cli import main
-from lmi_suspension.errors import ParameterError
+from lmi_suspension.errors import NonFiniteError, ParameterError
 from lmi_suspension.io import load_controller, save_controller, save_scheduled_controller
 from lmi_suspension.lti.gridded import GriddedController
 from lmi_suspension.seat import SeatParameters, bump, bump_limit, closed_loop_stable, simulate
@@ -66,7 +66,7 @@ def test_a_seat_runs_the_schedule_at_its_measured_values():
     # one controller, or none, is what it was
     assert controller_for_seat(K_SOFT, seat, {"m3": 5.0}) is K_SOFT
     assert controller_for_seat(None, seat) is None
-    with pytest.raises(ParameterError, match="finite"):
+    with pytest.raises(NonFiniteError, match="finite"):
         schedule_point(Ks, seat, {"m3": math.nan})
     speed = GriddedController.from_controllers({"speed": [10.0, 20.0]}, [K_SOFT, K_HARD])
     with pytest.raises(ParameterError, match="not a seat parameter"):

@@ -53,6 +53,7 @@ import control
 import numpy as np
 
 from ..errors import ParameterError
+from ..lti.checks import finite_scalar
 from .params import SeatParameters
 
 __all__ = ["SHIPPED_AT_MASS", "SHIPPED_SCHEDULED", "MassErrorRow", "MassRatioCurve",
@@ -81,16 +82,6 @@ def is_scheduled(K) -> bool:
             and hasattr(K, "names") and hasattr(K, "bounds"))
 
 
-def _finite(value, what: str) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ParameterError(f"{what} must be a number, got {value!r}") from None
-    if not math.isfinite(v):
-        raise ParameterError(f"{what} must be finite, got {value!r}")
-    return v
-
-
 def schedule_point(Ks, seat: SeatParameters, errors: Mapping | None = None) -> dict:
     """The values ``Ks`` is scheduled on for ``seat``: each scheduling parameter's true
     value (``seat``'s field of that name) plus its estimate error (``errors``, 0 where
@@ -115,7 +106,7 @@ def schedule_point(Ks, seat: SeatParameters, errors: Mapping | None = None) -> d
         if name not in _SEAT_FIELDS:
             raise ParameterError(f"the schedule is on {name!r}, not a seat parameter "
                                  f"({', '.join(_SEAT_FIELDS)})")
-        value = getattr(seat, name) + _finite(errors.get(name, 0.0), f"error of {name}")
+        value = getattr(seat, name) + finite_scalar(errors.get(name, 0.0), f"error of {name}")
         point[name] = float(min(max(value, float(lo)), float(hi)))
     return point
 
@@ -251,11 +242,11 @@ def sampled_schedule_check(Ks, *, dt: float = 1e-3, delays: Sequence = (0.0, 0.0
     points = schedule_nodes(Ks) if points is None else tuple(dict(p) for p in points)
     if not points:
         raise ParameterError("no scheduling values to check")
-    dt = _finite(dt, "dt")
-    tolerance = _finite(tolerance, "tolerance")
+    dt = finite_scalar(dt, "dt")
+    tolerance = finite_scalar(tolerance, "tolerance")
     if dt <= 0 or tolerance < 0:
         raise ParameterError(f"dt must be > 0 and tolerance >= 0, got {dt}, {tolerance}")
-    delays = tuple(_finite(d, "a delay") for d in delays)
+    delays = tuple(finite_scalar(d, "a delay") for d in delays)
     if not delays or min(delays) < 0:
         raise ParameterError(f"delays must be non-empty and >= 0, got {delays!r}")
     params = SeatParameters() if params is None else params
@@ -347,10 +338,10 @@ def ratio_over_mass(controllers: Mapping, masses: Sequence, *, delays=(0.0, 0.02
 
     params = SeatParameters() if params is None else params
     road = bump() if road is None else road
-    masses = tuple(_finite(m, "a mass") for m in masses)
+    masses = tuple(finite_scalar(m, "a mass") for m in masses)
     if not masses or min(masses) <= 0:
         raise ParameterError(f"masses must be non-empty and positive, got {masses!r}")
-    delays = tuple(_finite(d, "a delay") for d in delays)
+    delays = tuple(finite_scalar(d, "a delay") for d in delays)
     cache = {float(k): float(v) for k, v in (limits or {}).items()}
 
     def limit(m):
@@ -434,7 +425,7 @@ def inject_mass_error(Ks, samples, errors: Sequence, *, rng: np.random.Generator
     """
     from .scheduled import certify_scheduled
 
-    errors = tuple(_finite(e, "an error") for e in errors)
+    errors = tuple(finite_scalar(e, "an error") for e in errors)
     if not errors:
         raise ParameterError("give at least one error")
     ns, npf = len(samples.stability), len(samples.performance)
