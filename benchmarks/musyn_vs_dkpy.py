@@ -6,7 +6,8 @@ dkpy's run is its ``examples/1_example_dk_iter_fixed_order.py`` (dkpy 0.1.9):
 ``DkIterFixedOrder`` with the SLICOT K-step (``HinfSynSlicot``), the LMI bisection µ
 (``SsvLmiBisection(n_jobs=1)``, Clarabel), the SLICOT D-fit (``DScaleFitSlicot``), 3
 iterations, fit order 4, on ``np.logspace(-3, 3, 61)``.  ``musyn`` runs with its
-defaults on the same plant (dkpy's ``example_skogestad2006_p325()["P"]``, the
+defaults (the controller reduced to the least order within 1 % of the full order's µ;
+both are certified) on the same plant (dkpy's ``example_skogestad2006_p325()["P"]``, the
 project's :func:`~lmi_suspension.examples.skogestad_distillation` where dkpy is not
 installed) and the same grid.  The rounds alternate which one runs first.
 
@@ -85,7 +86,7 @@ def run_dkpy(dkpy, P, nmeas, ncon):
 def run_musyn(P, nmeas, ncon):
     t0, c0 = time.perf_counter(), _cpu()
     res = musyn(P, nmeas, ncon, BLK, omega=OMEGA)
-    return res.K, time.perf_counter() - t0, _cpu() - c0, res.mu_peak
+    return res.K, time.perf_counter() - t0, _cpu() - c0, res.mu_peak, res.K_full
 
 
 if __name__ == "__main__":
@@ -114,14 +115,16 @@ if __name__ == "__main__":
         for name in order:
             if name == "dkpy" and dkpy is None:
                 continue
-            K, seconds, cpu_s, own = (run_dkpy(dkpy, P, nmeas, ncon) if name == "dkpy"
-                                      else run_musyn(P, nmeas, ncon))
+            K, seconds, cpu_s, own, K_full = (run_dkpy(dkpy, P, nmeas, ncon) + (None,)
+                                              if name == "dkpy" else run_musyn(P, nmeas, ncon))
             times[name].append(seconds)
             cpu[name].append(cpu_s)
             print(f"round {r + 1} {name:5s}: {seconds:6.1f} s (CPU {cpu_s:6.1f} s), own µ "
                   f"{own:.4f}, certified µ "
-                  f"{certified_mu(P, K, nmeas, ncon):.4f}, controller order {K.nstates}",
-                  flush=True)
+                  f"{certified_mu(P, K, nmeas, ncon):.4f}, controller order {K.nstates}"
+                  + ("" if K_full is None else  # musyn's default order reduction
+                     f" (full order {K_full.nstates}: certified µ "
+                     f"{certified_mu(P, K_full, nmeas, ncon):.4f})"), flush=True)
     for label, table in (("wall", times), ("CPU", cpu)):
         med = {k: float(np.median(v)) for k, v in table.items() if v}
         line = f"median {label} seconds: " + ", ".join(f"{k} {v:.1f}" for k, v in med.items())

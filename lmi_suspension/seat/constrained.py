@@ -63,9 +63,10 @@ SHIPPED_TRADEOFF = Path(__file__).parent / "data" / "tradeoff.json"
 logger = logging.getLogger(__name__)
 
 #: D-K settings of the constrained design: the LMI K-step (the only one that takes
-#: constraints), constant D-scales as in DEFAULT_MUSYN, at most four iterations.
+#: constraints), constant D-scales as in DEFAULT_MUSYN, at most four iterations, the
+#: full-order controller as in DEFAULT_MUSYN (the shipped designs were made so).
 CONSTRAINED_MUSYN = MusynOptions(method="lmi", max_iter=4, patience=1, max_dfit_order=0,
-                                 n_dense=120, dscale_overrelax=1.0)
+                                 n_dense=120, dscale_overrelax=1.0, reduce_order=None)
 
 #: Design grid, rad/s: DEFAULT_OMEGA extended two decades down.  A constrained K-step's
 #: loop can lose performance near DC where the paper's design does not: the 4000 N design
