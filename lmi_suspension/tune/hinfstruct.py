@@ -145,6 +145,18 @@ class HinfstructOptions:
         COMPleib HE1 the local search from the other starts stops at local minima 2-29 %
         above the optimum, and this start is what comes within 1 % of it (+0.27 %).
         ``False`` keeps the tuning to the blocks' and the random starts.
+    reduced_lmi_start : bool
+        The same start for one :func:`~lmi_suspension.tune.tunable_ss` block (without
+        fixed parameter) of order below the plant's: the LMI's controller reduced to the
+        block's order by balanced truncation (python-control ``balred``, which keeps the
+        unstable part whole; no start where that part has more states than the block).
+        Off by default: measured 2026-12-02 on eight plants (the five COMPleib plants of
+        benchmarks/tune_table.py and plants b, d and the unstable one of
+        tests/test_tune.py), at one state below the plant's it lowered the best of two
+        starts from +4.13 % to +0.00 % (REA1), +1.49 % to +0.063 % (d), +13.1 % to
+        +0.51 % (b) and +4.6 % to +2.0 % (unstable) above ``hinfsyn``'s optimum, and did
+        not help on AC4, HE1, NN2 and REA2; at two or more states below it helped on
+        none.  It costs the LMI solve and one start.
     """
 
     max_iter: int = 200
@@ -155,6 +167,7 @@ class HinfstructOptions:
     on_unstable: str = "raise"
     full_order_gap: bool = True
     lmi_start: bool = True
+    reduced_lmi_start: bool = False
 
     def __post_init__(self):
         for name in ("max_iter", "stab_max_iter", "stall_iter"):
@@ -168,7 +181,7 @@ class HinfstructOptions:
         if self.on_unstable not in ("raise", "return"):
             raise ParameterError(f"on_unstable must be 'raise' or 'return', got "
                                  f"{self.on_unstable!r}")
-        for name in ("full_order_gap", "lmi_start"):
+        for name in ("full_order_gap", "lmi_start", "reduced_lmi_start"):
             v = getattr(self, name)
             if not isinstance(v, (bool, np.bool_)):
                 raise ParameterError(f"{name} must be True or False, got {v!r}")
@@ -199,8 +212,9 @@ class StartRecord:
     origin : str
         Where ``theta0`` came from: ``"blocks' start"``, ``"random"`` (a perturbation of
         it), ``"given"`` (a point passed in ``starts``), or, for a full-order block,
-        ``"LMI, closed-loop poles in |s| < R"`` or ``"hinfsyn"`` (see
-        ``HinfstructOptions.lmi_start``).
+        ``"LMI, closed-loop poles within R rad/s"`` (in ``|s| < R``) or ``"hinfsyn"`` (see
+        ``HinfstructOptions.lmi_start``), followed by ``", reduced to k states"`` for a
+        block of lower order (``HinfstructOptions.reduced_lmi_start``).
     """
 
     index: int
@@ -795,7 +809,8 @@ def hinfstruct(P, blocks, nmeas: int | None = None, ncon: int | None = None, *,
                if isinstance(starts, (numbers.Integral, np.integer)) else ["given"] * len(points))
     full = _full_order(blocks, G)
     synthesis = _Synthesis(G)
-    if full and opts.lmi_start:
+    if (opts.lmi_start and full) or (opts.reduced_lmi_start and _single_ss(blocks)
+                                     and block.nstates < G.nstates):
         extra = _lmi_start(G, block, synthesis)
         if extra is not None:
             points.append(extra[0])
@@ -846,12 +861,16 @@ def hinfstruct(P, blocks, nmeas: int | None = None, ncon: int | None = None, *,
                             gamma_opt=gamma_opt, gap=gap)
 
 
+def _single_ss(blocks) -> bool:
+    """Whether the structure is one :func:`~lmi_suspension.tune.tunable_ss` block."""
+    items = list(blocks) if isinstance(blocks, (list, tuple)) else [blocks]
+    return len(items) == 1 and getattr(items[0], "kind", None) == "tunable state space"
+
+
 def _full_order(blocks, G) -> bool:
     """Whether the structure is one tunable state-space block of at least the plant's
     order (the only structure whose optimum is hinfsyn's: no other one is compared)."""
-    items = list(blocks) if isinstance(blocks, (list, tuple)) else [blocks]
-    return (len(items) == 1 and getattr(items[0], "kind", None) == "tunable state space"
-            and items[0].nstates >= G.nstates)
+    return _single_ss(blocks) and block_diagonal(blocks).nstates >= G.nstates
 
 
 class _Synthesis:
@@ -905,8 +924,9 @@ _LMI_START_RTOL = 1e-6
 def _lmi_start(G, block, synthesis: _Synthesis):
     """``(theta, origin)``: the full-order LMI's controller with its closed-loop poles
     in ``|s| < R`` (``_LMI_START_RADIUS``), padded with unreachable modes to the block's
-    order and realized in its modal form; ``hinfsyn``'s controller where that LMI
-    fails; ``None`` where neither gives a start (logged at INFO)."""
+    order (or balanced-truncated to it, for a block of lower order) and realized in its
+    modal form; ``hinfsyn``'s controller where that LMI fails; ``None`` where neither
+    gives a start (logged at INFO)."""
     if block.n_params != len(block._labels):
         logger.info("no LMI start: the block has fixed parameters, which the LMI's "
                     "controller does not meet")
@@ -916,7 +936,7 @@ def _lmi_start(G, block, synthesis: _Synthesis):
     radius = _LMI_START_RADIUS * max(fastest, 1.0)
     try:
         K = msyn(G, G.ny, G.nu, LmiHinfBound(), [Disk(radius=radius)]).K
-        origin = f"LMI, closed-loop poles in |s| < {radius:.4g}"
+        origin = f"LMI, closed-loop poles within {radius:.4g} rad/s"
     except LmiSuspensionError as exc:
         logger.info("LMI start with closed-loop poles in |s| < %.4g: %s; hinfsyn's "
                     "controller instead", radius, exc)
@@ -924,6 +944,11 @@ def _lmi_start(G, block, synthesis: _Synthesis):
         if syn is None:
             return None
         K, origin = syn.K, "hinfsyn"
+    if block.nstates < K.nstates:
+        K = _truncated(K, block.nstates)
+        if K is None:
+            return None
+        origin += f", reduced to {block.nstates} states"
     try:
         theta = _realized(K, block)
     except (ParameterError, NonFiniteError, np.linalg.LinAlgError) as exc:
@@ -940,6 +965,21 @@ def _lmi_start(G, block, synthesis: _Synthesis):
             logger.info("the LMI start's closed-loop norm is %.9g in the block's "
                         "realization, %.9g in the LMI's", g_block, g_lmi)
     return theta, origin
+
+
+def _truncated(K, order):
+    """``K`` balanced-truncated to ``order`` states, or ``None`` (logged at INFO)."""
+    try:
+        Kr = control.balred(K, order, method="truncate")
+    except Exception as exc:    # noqa: BLE001 - slycot's ValueError/ArithmeticError variants
+        logger.info("no reduced LMI start: balanced truncation to %d states failed: %s",
+                    order, exc)
+        return None
+    if Kr.nstates != order:     # balred keeps the unstable part whole
+        logger.info("no reduced LMI start: the LMI's controller has more unstable poles "
+                    "than the block's %d states", order)
+        return None
+    return Kr
 
 
 def _realized(K, block) -> np.ndarray:
