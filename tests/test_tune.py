@@ -1039,8 +1039,8 @@ def test_he1_full_order_within_one_percent_of_the_hinfsyn_optimum():
     realization by msyn's controller, recomputed here, whose closed-loop norm the start
     must reproduce.  One other start of 20 iterations keeps the test fast: a start's
     search only descends, so the default budget ends at or below this γ.  Measured
-    2026-12-02: +0.266 % (the LMI start, 0 iterations: the line search finds no descent
-    from it), 2.3 s."""
+    2026-12-02: +0.266 % natively (OpenBLAS SkylakeX) and under Sandybridge (the LMI
+    start, 0 iterations: the line search finds no descent from it), 1.0 s of CPU."""
     from lmi_suspension.examples import compleib
     from lmi_suspension.synthesis.constraints import Disk
     from lmi_suspension.synthesis.constraints import HinfBound as LmiHinfBound
