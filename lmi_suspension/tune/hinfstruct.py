@@ -156,7 +156,8 @@ class HinfstructOptions:
         starts from +4.13 % to +0.00 % (REA1), +1.49 % to +0.063 % (d), +13.1 % to
         +0.51 % (b) and +4.6 % to +2.0 % (unstable) above ``hinfsyn``'s optimum, and did
         not help on AC4, HE1, NN2 and REA2; at two or more states below it helped on
-        none.  It costs the LMI solve and one start.
+        none (``python benchmarks/tune_table.py reduced`` prints the COMPleib part).  It
+        costs the LMI solve and one start.
     """
 
     max_iter: int = 200
@@ -912,7 +913,8 @@ class _Synthesis:
 #: hinfsyn's optimum, the worst of the five (HE1, or NN2 at 10): factor 10: +1.66 %
 #: (HE1), +1.03 % (NN2); 30: +0.59 %; 100: +0.27 %; 300: +0.11 %.  100 is the smallest
 #: of these with a margin of 3 or more below the 1 % of issue 60's acceptance; the
-#: controllers' fastest poles there were 476 rad/s (HE1) against 4880 for hinfsyn's.
+#: controllers' fastest poles there were 476 rad/s (HE1) against 4880 for hinfsyn's
+#: (``python benchmarks/tune_table.py radius`` prints the table).
 _LMI_START_RADIUS = 100.0
 #: the start's closed-loop norm realized in the block's modal form may differ from the
 #: LMI controller's by round-off; beyond this (relative) the difference is logged.  On the
