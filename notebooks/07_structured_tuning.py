@@ -149,9 +149,11 @@ plt.show()
 # On this plant a first-order controller already reaches the full-order optimum (to the
 # LMI solver's accuracy); a static gain cannot. That is not the rule: on plants whose
 # optimal controllers have a pole running to −∞ as γ approaches the optimum, a full-order
-# search approaches it slowly, and the default budget (2 starts of 200 iterations) ends
-# several percent above it -- the guide's "What to expect" gives the measurements, and
-# `tunable_ss(..., start=K)` starts from a controller of one's own.
+# search from the blocks' and random starts approaches it slowly, and the default budget
+# (2 starts of 200 iterations) ends several percent above it. A full-order block
+# therefore also gets the LMI start (the full-order LMI's controller with its closed-loop
+# poles bounded; `r.best_origin` says when it won) -- the guide's "What to expect" gives
+# the measurements, and `tunable_ss(..., start=K)` starts from a controller of one's own.
 #
 # ## Two models: one PI for two plants, with margins as a hard requirement
 #

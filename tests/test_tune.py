@@ -463,9 +463,12 @@ def test_full_order_on_a_three_state_plant_within_a_few_percent():
     iteration bound, against the optimum 0.5803086: 0.5928082 (+2.15 %) under OpenBLAS
     Haswell, 0.5941402 under Sandybridge, 0.5947135 (+2.48 %) under Nehalem, the same on
     1 and 2 threads (../shared/tools/kernels).  Path-dependent: the bound below is 5 %;
-    the lower bound holds always."""
+    the lower bound holds always.  The search alone (``lmi_start=False``): the LMI start,
+    on by default, ends 5e-6 above the optimum here (0 iterations) and would hide it."""
     P = plant_d()
-    res = hinfstruct(P, tunable_ss("K", 3, 1, 1), starts=2, rng=np.random.default_rng(0))
+    res = hinfstruct(P, tunable_ss("K", 3, 1, 1), starts=2, rng=np.random.default_rng(0),
+                     options=HinfstructOptions(lmi_start=False))
+    assert [s.origin for s in res.starts] == ["blocks' start", "random"]
     # hinfsyn's optimum (reported by hinfstruct) brackets SLICOT's bisection
     ref = _slicot_gamma_opt(P, 0.5 * res.gamma_opt, 1.01 * res.gamma_opt)
     assert res.gamma_opt == pytest.approx(ref, rel=1e-4)
@@ -1023,6 +1026,106 @@ def test_he1_comes_near_its_optimum_with_slow_closed_loop_poles():
     CL = lft(P, K)
     assert np.abs(np.linalg.eigvals(np.asarray(CL.A))).max() < 30.0
     assert 0.0 < hinfnorm(CL)[0] / lower - 1 < 0.015
+
+
+def test_he1_full_order_within_one_percent_of_the_hinfsyn_optimum():
+    """Issue 60's acceptance on HE1 (4 states, D21 = 0): a full-order block within 1 % of
+    hinfsyn's certified optimum (gamma_lower, a lower bound for every controller,
+    computed here).  The search's own starts stop at local minima 2-29 % above it
+    (benchmarks/tune_table.py he1); the start that comes within 1 % is the LMI start
+    (HinfstructOptions.lmi_start): the full-order LMI's controller with every closed-loop
+    pole in |s| < 100 times the plant's fastest mode, realized in the block's modal form.
+    Checked here by routes the tuner did not use: γ by hinfnorm of lft(P, res.K); the
+    realization by msyn's controller, recomputed here, whose closed-loop norm the start
+    must reproduce.  One other start of 20 iterations keeps the test fast: a start's
+    search only descends, so the default budget ends at or below this γ.  Measured
+    2026-12-02: +0.266 % natively (OpenBLAS SkylakeX) and under Sandybridge (the LMI
+    start, 0 iterations: the line search finds no descent from it), 1.0 s of CPU."""
+    from lmi_suspension.examples import compleib
+    from lmi_suspension.synthesis.constraints import Disk
+    from lmi_suspension.synthesis.constraints import HinfBound as LmiHinfBound
+    from lmi_suspension.synthesis.multiobjective import msyn
+    P = compleib("HE1")
+    lower = hinfsyn(P, P.ny, P.nu).gamma_lower
+    block = tunable_ss("K", P.nstates, P.nu, P.ny)
+    res = hinfstruct(P, block, starts=1, options=HinfstructOptions(max_iter=20))
+    gamma = hinfnorm(lft(P, res.K))[0]
+    assert gamma == res.gamma and res.gamma_opt == lower
+    assert lower * (1 - 1e-5) <= gamma <= lower * 1.01
+    assert res.best_origin.startswith("LMI, closed-loop poles within")
+    assert [s.origin for s in res.starts][:-1] == ["blocks' start"]
+    # the start is the LMI's controller, exactly: the same closed-loop norm
+    radius = hs._LMI_START_RADIUS * np.abs(np.linalg.eigvals(np.asarray(P.A))).max()
+    K, _, _, _ = msyn(P, P.ny, P.nu, LmiHinfBound(), [Disk(radius=radius)])
+    g_lmi = hinfnorm(lft(P, K))[0]
+    assert hinfnorm(lft(P, block.ss(res.starts[-1].theta0)))[0] == pytest.approx(g_lmi,
+                                                                                 rel=1e-9)
+    assert gamma <= g_lmi
+
+
+def test_the_lmi_start_is_added_for_full_order_blocks_only():
+    """The LMI start (HinfstructOptions.lmi_start) joins a single tunable_ss of at least
+    the plant's order, without fixed parameters, and says where it came from: above the
+    plant's order the LMI's controller is padded with unreachable modes (the same closed
+    loop); on a plant with D22 ≠ 0, which msyn refuses, it is hinfsyn's controller
+    (certified by hinfsyn, within its gamma_relax of the optimum)."""
+    P = plant_a()                                                    # 2 states
+    short = HinfstructOptions(max_iter=3)
+    for blocks in (tunable_ss("K", 1, 1, 1), tunable_pid("C", "PI"),
+                   tunable_ss("K", 2, 1, 1, fixed={"B[0,0]": 1.0})):
+        res = hinfstruct(P, blocks, starts=2, options=short)
+        assert [s.origin for s in res.starts] == ["blocks' start", "random"]
+    res = hinfstruct(P, tunable_ss("K", 2, 1, 1), starts=2,
+                     options=HinfstructOptions(max_iter=3, lmi_start=False))
+    assert len(res.starts) == 2
+    res = hinfstruct(P, tunable_ss("K", 2, 1, 1), starts=[tunable_ss("K", 2, 1, 1).start],
+                     options=short)
+    assert res.starts[0].origin == "given" and res.starts[1].origin.startswith("LMI")
+    # above the plant's order: the padded start closes the same loop as a 2-state one
+    big = tunable_ss("K", 3, 1, 1)
+    res = hinfstruct(P, big, options=short)
+    lmi = res.starts[-1]
+    assert lmi.origin.startswith("LMI") and res.best_origin == res.starts[res.best].origin
+    g3 = hinfnorm(lft(P, big.ss(lmi.theta0)))[0]
+    radius = hs._LMI_START_RADIUS * max(np.abs(np.linalg.eigvals(np.asarray(P.A))).max(), 1.0)
+    from lmi_suspension.synthesis.constraints import Disk
+    from lmi_suspension.synthesis.constraints import HinfBound as LmiHinfBound
+    from lmi_suspension.synthesis.multiobjective import msyn
+    K, _, _, _ = msyn(P, 1, 1, LmiHinfBound(), [Disk(radius=radius)])
+    assert g3 == pytest.approx(hinfnorm(lft(P, K))[0], rel=1e-9)
+    # D22 ≠ 0: hinfsyn's controller
+    Pb = plant_biproper()
+    syn = hinfsyn(Pb, 1, 1)
+    block = tunable_ss("K", Pb.nstates, 1, 1)
+    res = hinfstruct(Pb, block, options=short)
+    assert res.starts[-1].origin == "hinfsyn"
+    assert hinfnorm(lft(Pb, block.ss(res.starts[-1].theta0)))[0] == pytest.approx(syn.gamma,
+                                                                                  rel=1e-9)
+    assert res.gamma <= syn.gamma * (1 + 1e-9)
+    for bad in ({"lmi_start": "yes"}, {"reduced_lmi_start": 1}):
+        with pytest.raises(ParameterError):
+            HinfstructOptions(**bad)
+
+
+def test_a_reduced_lmi_start_on_request_below_full_order():
+    """REA1 (4 states, 3 × 2) at order 3: the blocks' start and a random one stop 4.1 %
+    above hinfsyn's full-order optimum (which bounds every order from below); with
+    reduced_lmi_start the LMI's controller balanced-truncated to 3 states is one more
+    start, and reaches that optimum.  Off by default.  γ certified by hinfnorm of
+    lft(P, res.K); the bound by hinfsyn, computed here.  Measured 2026-12-02: -2e-8
+    relative (the LMI's accuracy), the start 2e-5 above before its 20 iterations."""
+    from lmi_suspension.examples import compleib
+    P = compleib("REA1")
+    lower = hinfsyn(P, P.ny, P.nu).gamma_lower
+    block = tunable_ss("K", 3, P.nu, P.ny)
+    short = HinfstructOptions(max_iter=20)
+    res = hinfstruct(P, block, options=short)
+    assert [s.origin for s in res.starts] == ["blocks' start"] and res.gap is None
+    res = hinfstruct(P, block, options=HinfstructOptions(max_iter=20, reduced_lmi_start=True))
+    assert res.best_origin.startswith("LMI") and res.best_origin.endswith("reduced to 3 states")
+    gamma = hinfnorm(lft(P, res.K))[0]
+    assert gamma == res.gamma and res.K.nstates == 3
+    assert lower * (1 - 1e-5) <= gamma <= lower * 1.01
 
 
 def test_static_output_feedback_on_compleib_nn2_against_a_grid():
