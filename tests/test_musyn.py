@@ -22,8 +22,11 @@ def distillation_design():
     ex = skogestad_distillation()
     records = []
     omega = np.logspace(-3, 3, 61)  # the book's grid (and dkpy's example of the problem)
+    # full order: the tests below compare the returned loop with its iterate's γ (the
+    # reduction's own guarantee is test_auto_order_reduction_keeps_mu_within_its_tolerance)
     res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=omega,
-                options=MusynOptions(max_iter=6, patience=3, method="best"),
+                options=MusynOptions(max_iter=6, patience=3, method="best",
+                                     reduce_order=None),
                 callback=records.append)
     return ex, res, records
 
@@ -34,7 +37,8 @@ def distillation_dk():
     ex = skogestad_distillation()
     records = []
     res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-3, 3, 61),
-                options=MusynOptions(max_iter=6, patience=3, method="best", dscale_search=0),
+                options=MusynOptions(max_iter=6, patience=3, method="best", dscale_search=0,
+                                     reduce_order=None),
                 callback=records.append)
     return ex, res, records
 
@@ -1120,7 +1124,11 @@ def test_default_lmi_dk_on_distillation_goes_below_one():
     assert res.best_iteration == 4
     assert res.mu_peak < 0.99
     best = res.history[res.best_iteration - 1]
-    assert res.mu_peak <= best.gamma * (1 + 1e-3)
+    # the default reduces the controller (22 states to 15 on this problem, measured
+    # 2026-12-02): the full-order loop is bounded by its γ, the reduced one within 1 %
+    full = res.mu_peak if res.reduced_from is None else res.mu_peak_full
+    assert full <= best.gamma * (1 + 1e-3)
+    assert res.mu_peak <= full * (1 + MusynOptions().reduce_mu_tol)
     assert res.mu_lower_peak >= 0.99 * res.mu_peak
     assert np.all(res.CL.poles().real < 0)
 
