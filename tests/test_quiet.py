@@ -119,7 +119,29 @@ def test_a_loose_dscale_fit_is_told_by_met_and_logged_at_info(caplog):
                for r in seen.records)
 
 
-def test_an_inaccurate_gscale_solve_is_logged_at_info_not_warned(monkeypatch, caplog):
+def test_an_inaccurate_gscale_solve_is_logged_at_info_not_warned(caplog):
+    """CVXPY's "Solution may be inaccurate" (a UserWarning) on a G-scaling problem: the
+    status is handled where it is checked, and the note goes to the log at INFO."""
+    from lmi_suspension.mu import gfit
+
+    class Inaccurate:
+        status = None
+
+        def solve(self, **kwargs):
+            # what cvxpy does on Clarabel's AlmostSolved
+            warnings.warn("Solution may be inaccurate. Try another solver, adjusting the "
+                          "solver settings, or solve with verbose=True for more "
+                          "information.", UserWarning, stacklevel=2)
+            self.status = "optimal_inaccurate"
+
+    with heard(caplog) as seen:
+        gfit._solve(Inaccurate(), "optimal G-scalings")
+    assert seen.loud == []
+    assert any("inaccurate" in r.getMessage() and r.levelno == logging.INFO
+               for r in seen.records)
+
+
+def test_an_almost_solved_lmi_is_logged_at_info_not_warned(monkeypatch, caplog):
     """Clarabel's AlmostSolved on a G-scaling problem (posed for Clarabel directly,
     :mod:`lmi_suspension.mu.lmisolve`; injected): the solution is used, and the note goes
     to the log at INFO."""

@@ -42,6 +42,7 @@ mixed-µ bounds of its true closed loop, not by the scalings.
 from __future__ import annotations
 
 import logging
+import warnings
 from dataclasses import dataclass
 
 import control
@@ -143,60 +144,65 @@ def central_dg(M, struct: BlockStructure, beta: float, g_max: float = 5.0):
     margin : numpy.ndarray, shape (n_freq,)
         ``t`` at each frequency (``>= 0``: the scalings certify µ ≤ β there).
     """
-    from .lmisolve import solve_lmi
+    import cvxpy as cp
 
     M = np.asarray(M)
     nout, nin, nf = M.shape
     nb = struct.n_blocks
+    x = cp.Variable(nb)
+    gv = cp.Variable(nb)
+    t = cp.Variable()
     zs, ws = struct.row_slices(), struct.col_slices()  # M's rows (z) and columns (w)
     EL = [np.zeros((nout, nout)) for _ in range(nb)]
     ER = [np.zeros((nin, nin)) for _ in range(nb)]
     for i, (z, w) in enumerate(zip(zs, ws)):
         EL[i][z, z] = np.eye(z.stop - z.start)
         ER[i][w, w] = np.eye(w.stop - w.start)
+    XR = sum(x[i] * ER[i] for i in range(nb))
     real = [i for i, b in enumerate(struct.blocks) if b.is_real]
+    # M* X_L M = Σ x_i M* E_i M and j(G M - M* G*) = Σ g_i j(S_i M - M* S_iᵀ): with
+    # these products as the parameters the problem is DPP, compiled once for all ω
+    Q = [cp.Parameter((nin, nin), complex=True) for _ in range(nb)]
     S = {i: _selector(ws[i], zs[i], nin, nout) for i in real}
-    nr = len(real)
-    # variables [x_1..x_nb, g_r (real blocks), t]; maximise t subject to
-    # β² X_R - Σ x_i M* E_i M - Σ g_r j(S_r M - M* S_rᵀ) - t I ⪰ 0, posed for Clarabel
-    # directly (:mod:`.lmisolve`): through CVXPY the problem was rebuilt per call
-    nvar = nb + nr + 1
-    c = np.zeros(nvar)
-    c[-1] = -1.0
-    Eq = np.zeros((1, nvar))
-    Eq[0, nb - 1] = 1.0
-    rows = [-np.eye(nvar)[:nb]]  # x >= 1e-9
-    rhs = [np.full(nb, -1e-9)]
-    top = np.zeros((1, nvar))
-    top[0, -1] = 1.0  # t <= 1
-    rows.append(top)
-    rhs.append([1.0])
-    for k, i in enumerate(real):  # |g_r| <= g_max β x_i
-        for sign in (1.0, -1.0):
-            row = np.zeros((1, nvar))
-            row[0, nb + k] = sign
-            row[0, i] = -g_max * beta
-            rows.append(row)
-            rhs.append([0.0])
-    Gin, hin = np.vstack(rows), np.concatenate([np.ravel(r) for r in rhs])
+    R = {i: cp.Parameter((nin, nin), complex=True) for i in real}
+    H = (beta**2 * XR - sum(x[i] * Q[i] for i in range(nb))
+         - sum((gv[i] * R[i] for i in real), np.zeros((nin, nin))) - t * np.eye(nin))
+    cons = [(H + H.H) / 2 >> 0, x[nb - 1] == 1, x >= 1e-9, t <= 1.0]
+    cons += [cp.abs(gv[i]) <= g_max * beta * x[i] for i in real]
+    cons += [gv[i] == 0 for i in range(nb) if i not in real]
+    prob = cp.Problem(cp.Maximize(t), cons)
     d = np.empty((nb, nf))
-    g = np.empty((nr, nf))
+    g = np.empty((len(real), nf))
     margin = np.empty(nf)
-    F = np.zeros((1, nvar, nin, nin), dtype=complex)
-    F[0, -1] = -np.eye(nin)
     for k in range(nf):
         Mk = M[:, :, k]
         for i in range(nb):
-            F[0, i] = beta**2 * ER[i] - Mk.conj().T @ EL[i] @ Mk
-        for r, i in enumerate(real):
-            F[0, nb + r] = -1j * (S[i] @ Mk - Mk.conj().T @ S[i].T)
-        sol = solve_lmi(c, np.zeros((1, nin, nin)), F, G=Gin, h=hin, E=Eq, f=[1.0],
-                        what=f"central D-G scalings at frequency index {k}")
-        xv = np.maximum(sol.x[:nb], 1e-12)
+            Q[i].value = Mk.conj().T @ EL[i] @ Mk
+        for i in real:
+            R[i].value = 1j * (S[i] @ Mk - Mk.conj().T @ S[i].T)
+        _solve(prob, f"central D-G scalings at frequency index {k}")
+        if prob.status not in ("optimal", "optimal_inaccurate") or x.value is None:
+            raise SolverError(f"central D-G scalings: solver status {prob.status} at "
+                              f"frequency index {k}")
+        xv = np.maximum(np.asarray(x.value), 1e-12)
         d[:, k] = np.sqrt(xv)
-        g[:, k] = [float(sol.x[nb + r]) / (xv[i] * beta) for r, i in enumerate(real)]
-        margin[k] = float(sol.x[-1])
+        g[:, k] = [float(gv.value[i]) / (xv[i] * beta) for i in real]
+        margin[k] = float(t.value)
     return d, g, margin
+
+
+def _solve(prob, what: str) -> None:
+    """Solve with Clarabel.  An inaccurate solution is used as it is: scalings only
+    choose the plant of the next K-step, and the µ bound of the loop it leads to is
+    computed afresh, so CVXPY's warning is replaced by an INFO record."""
+    import cvxpy as cp
+
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message="Solution may be inaccurate",
+                                category=UserWarning)
+        prob.solve(solver=cp.CLARABEL)
+    if prob.status == "optimal_inaccurate":
+        logger.info("%s: the solver's solution is inaccurate; used as it is", what)
 
 
 def _selector(rs: slice, cs: slice, nin: int, nout: int) -> np.ndarray:
