@@ -703,3 +703,45 @@ def test_the_k_steps_reduced_plant_keeps_its_error_bound_and_the_axis_modes(capl
     assert same is P and b0 == 0.0
     assert any("no reduction" in r.getMessage() and r.levelno == logging.INFO
                for r in caplog.records)
+
+
+@pytest.mark.parametrize("changed", [False, True])
+def test_a_reduced_k_step_plant_is_used_only_where_the_previous_loop_keeps_its_level(
+        loop, monkeypatch, caplog, changed):
+    """D-G-K's fit step hands the K-step the reduced scaled plant only where the
+    controller it was built around has the same norm on it as on the full plant (an
+    open-loop truncation bound says nothing through the loop; the seat over m3 and k1:
+    1.77 against 1.00, 2026-12-02).  Injected: a "reduction" that is the full plant in
+    another realization (kept), and one whose w -> z feedthrough moved (refused: the
+    full plant, with the previous controller's norm on it, and an INFO record)."""
+    import logging
+
+    from lmi_suspension.mu.dk import _setup
+    from lmi_suspension.mu.steps import fit as fitmod
+    from lmi_suspension.mu.steps.dgstep import MussvStep
+
+    P, K, struct, w, M = loop
+    setup, _ = _setup(P, 1, 1, BLK, w, MusynOptions(max_gfit_poles=2, max_dfit_order=1),
+                      np.random.default_rng(0), (), None, None)
+    here = MussvStep(setup)(_mu_part(lft(P, K), struct), K)
+    full = {}
+
+    def fake(PD, tol=1e-2):
+        full["PD"] = PD
+        T = np.diag(np.linspace(1.0, 2.0, PD.nstates))  # same plant, other coordinates
+        moved = np.zeros_like(np.asarray(PD.D))
+        if changed:
+            moved[:2, :2] = 0.5
+        return control.ss(T @ PD.A @ np.linalg.inv(T), T @ PD.B, PD.C @ np.linalg.inv(T),
+                          np.asarray(PD.D) + moved), 1e-3
+
+    monkeypatch.setattr(fitmod, "reduced_for_kstep", fake)
+    with caplog.at_level(logging.INFO, logger=fitmod.__name__):
+        nxt = fitmod.DGScaleFit(setup)(here, iteration=1, best_iteration=1)
+    level = float(hinfnorm(_mu_part(lft(full["PD"], K), struct))[0])
+    if changed:
+        assert nxt.PD is full["PD"] and nxt.gamma == pytest.approx(level, rel=1e-9)
+        assert any("sees it whole" in r.getMessage() and r.levelno == logging.INFO
+                   for r in caplog.records)
+    else:
+        assert nxt.PD is not full["PD"] and nxt.gamma == pytest.approx(level, rel=1e-3)
