@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import functools
 import logging
+import warnings
 from dataclasses import replace
 
 import control
@@ -215,7 +216,11 @@ def reduced_for_kstep(PD: control.StateSpace, tol: float = _KSTEP_REDUCE_TOL):
         if n < 2:
             return PD, 0.0
         A, B, C = (np.asarray(x, dtype=float) for x in (stable.A, stable.B, stable.C))
-        *_, hsv = ab09ad("C", "B", "S", n, m, p, A.copy(), B.copy(), C.copy(), nr=n)
+        with warnings.catch_warnings():
+            # slycot warns where the stable part is not minimal (the order is then
+            # its minimal one, and the dropped singular values are zeros)
+            warnings.simplefilter("ignore")
+            *_, hsv = ab09ad("C", "B", "S", n, m, p, A.copy(), B.copy(), C.copy(), nr=n)
         hsv = np.sort(np.asarray(hsv, dtype=float))[::-1]
         if not np.all(np.isfinite(hsv)):
             raise ValueError(f"Hankel singular values {hsv}")
@@ -223,7 +228,10 @@ def reduced_for_kstep(PD: control.StateSpace, tol: float = _KSTEP_REDUCE_TOL):
         r = int(next(k for k in range(n + 1) if tail[k] <= tol))
         if r >= n:
             return PD, 0.0
-        nr, Ar, Br, Cr, _ = ab09ad("C", "B", "S", n, m, p, A.copy(), B.copy(), C.copy(), nr=r)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            nr, Ar, Br, Cr, _ = ab09ad("C", "B", "S", n, m, p, A.copy(), B.copy(), C.copy(),
+                                       nr=r)
         reduced = control.ss(Ar[:nr, :nr], Br[:nr], Cr[:, :nr], np.zeros((p, m)))
         PDr = control.parallel(reduced, rest) if rest.nstates else control.ss(
             reduced.A, reduced.B, reduced.C, np.asarray(rest.D))
