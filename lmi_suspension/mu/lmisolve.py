@@ -1,11 +1,15 @@
 """Small Hermitian LMI problems posed for Clarabel directly (no modelling layer).
 
-D-G-K's scalings (:mod:`.gfit`) solve one SDP over the grid per fit and one small SDP
-per grid frequency, each a problem of the same shape with new data.  Through CVXPY
-every one of them was compiled afresh: on the seat over m3 and k1 (``complex_candidate
-="start"``) CVXPY's problem rebuilding was 10.1 s of the fits' 13.0 s (103 problems,
-2026-12-02).  Here the problem data are assembled with numpy in a few milliseconds
-and handed to Clarabel, the solver CVXPY called.
+D-G-K's optimal G-scalings (:func:`~lmi_suspension.mu.gfit.optimal_gscales`) solve one
+SDP over the grid per basis size and fit, a problem of the same shape each time with
+new data.  Through CVXPY every one was compiled afresh, and the compilation was most of
+the fits' time (a profile of the seat over m3 and k1, ``complex_candidate="start"``:
+23.5 of 31.4 s, 2026-12-02); assembled with numpy and handed to Clarabel, the solver
+CVXPY called, the two-mass plant's took 0.31 s of CPU instead of 3.37 s for the same
+level (2.1099312 against 2.1099170).  The per-frequency problems of
+:func:`~lmi_suspension.mu.gfit.central_dg` stay on CVXPY: their DPP form is compiled
+once per call, and their optimum is not unique (the margin is capped), so a different
+formulation moves the point the interior-point method returns, and D-G-K's path with it.
 
 A Hermitian ``H = X + jY ⪰ 0`` is posed as its real embedding ``[[X, -Y], [Y, X]] ⪰ 0``
 in Clarabel's ``PSDTriangleConeT`` (the upper triangle stacked by columns, off-diagonal
