@@ -141,6 +141,35 @@ def test_an_inaccurate_gscale_solve_is_logged_at_info_not_warned(caplog):
                for r in seen.records)
 
 
+def test_an_almost_solved_lmi_is_logged_at_info_not_warned(monkeypatch, caplog):
+    """Clarabel's AlmostSolved on a G-scaling problem (posed for Clarabel directly,
+    :mod:`lmi_suspension.mu.lmisolve`; injected): the solution is used, and the note goes
+    to the log at INFO."""
+    import clarabel
+
+    from lmi_suspension.mu import lmisolve
+
+    class AlmostSolved:
+        def __init__(self, P, q, A, b, cones, settings):
+            self.n = len(q)
+
+        def solve(self):
+            class Sol:
+                status = "SolverStatus.AlmostSolved"
+            sol = Sol()
+            sol.x = [1.0] * self.n
+            return sol
+
+    monkeypatch.setattr(clarabel, "DefaultSolver", AlmostSolved)
+    with heard(caplog) as seen:
+        sol = lmisolve.solve_lmi([1.0], [[[0.0, 1.0], [1.0, 0.0]]], [[[[1.0, 0.0], [0.0, 1.0]]]],
+                                 what="optimal G-scalings")
+    assert sol.status == "optimal_inaccurate"
+    assert seen.loud == []
+    assert any("inaccurate" in r.getMessage() and r.levelno == logging.INFO
+               for r in seen.records)
+
+
 def test_crossed_mu_bounds_are_in_the_result_and_logged_not_warned(monkeypatch, caplog):
     """A lower bound above the upper one beyond round-off means one of them is wrong:
     the caller asked for both and cannot have them, so it is a WARNING, carried in

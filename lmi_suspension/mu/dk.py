@@ -248,7 +248,11 @@ class MusynOptions:
         plain (``dscale_overrelax`` is not used) and there is no D-scale search; the
         per-frequency µ bounds with real blocks are LMIs, and each real block adds
         states to the scaled plant (three per basis pole, 9 to 30), so each iteration
-        costs more than a complex one.  Measured on the oscillator of
+        costs more than a complex one.  The K-step sees that plant balanced-truncated
+        (error bound 0.01, where the previous controller's level on it stays within 2 %
+        of the full plant's; :func:`.steps.fit.reduced_for_kstep`): on the two-mass
+        plant its 34-38 states went to 23-30, the default run from 70 s to 37 s of CPU
+        (µ 1.6089 with 25 states against 1.6140 with 36; 2026-12-02).  Measured on the oscillator of
         ``tests/test_dgk.py`` (±50 % real stiffness, 40-point grid, no D-scale search;
         2026-11-27): complex D-K ends at mixed µ 1.1326, D-G-K at 1.0069 (iteration 5;
         ``benchmarks/bench_dgk.py``, figures in ``docs/guide/dk.md``).
@@ -275,8 +279,13 @@ class MusynOptions:
         can end above complex D-K (the seat over m3 and k1: 2.734 against 2.671,
         2026-11-27; 2.7407 against 2.6711 on 2026-12-02, where ``"start"`` reaches
         2.6646 with 31 states; the two-mass plant weighted 1 and 1, with 10 G poles: 2.7340 against
-        2.6355, its second K-step failing, 2026-12-02).  With ``K0``, the complexified run starts
-        from it.
+        2.6355, its second K-step failing, 2026-12-02).  Re-measured with the reduced
+        K-step plants and the direct G-scaling SDP (2026-12-02, ``benchmarks/HISTORY.md``):
+        two-mass ``"keep"`` 1.6089 (25 states), ``"start"`` 1.7779 (the complexified
+        controller; D-G-K's second iterate 1.8110); seat ``"keep"`` 2.6711 (the
+        complexified controller; D-G-K's own 2.7546), ``"start"`` 2.6063 (31 states).
+        Neither start wins on both, so the default stays ``"keep"``.  With ``K0``, the
+        complexified run starts from it.
     max_gfit_poles : int or None
         D-G-K: the largest basis of the G-scalings (poles per real block; each adds
         three states to the scaled plant per real channel, so this bounds the order of

@@ -52,15 +52,46 @@ def check_stabilizable(P: GeneralizedPlant) -> None:
     scale_b = max(1.0, np.linalg.norm(np.hstack([A, B2]), 2))
     scale_c = max(1.0, np.linalg.norm(np.vstack([A, C2]), 2))
     kind = "z" if P.dt else "s"
-    for lam in _unstable_modes(A, P.dt):
-        M = np.hstack([A - lam * np.eye(n), B2])
+    if not _unstable_modes(A, P.dt).size:
+        return
+    # each test on the unstable part alone (ordered Schur form): on the full A, a stable
+    # mode next to an unstable one makes A - λI nearly singular whatever B2 and C2 do.
+    # A D-scaled two-mass plant (a rigid-body double pole at 0, split by roundoff into
+    # ±4.3e-8j, beside stable scaling modes at -4.7e-7 and -4e-6) failed the full-A test
+    # (smallest singular value 1.1e-7 against 3.3e-7) though u moves the rigid-body mode
+    # (2026-12-02): the controllable and observable parts are exactly those of the
+    # unstable block in these coordinates (left eigenvectors [0, w] for T22, right
+    # eigenvectors [v; 0] for T11)
+    T22, B2u = _unstable_block(A, B2, P.dt)
+    for lam in np.linalg.eigvals(T22):
+        M = np.hstack([T22 - lam * np.eye(T22.shape[0]), B2u])
         if np.linalg.svd(M, compute_uv=False)[-1] <= PBH_TOL * scale_b:
             raise InfeasibleError(f"(A, B2) is not stabilisable: the unstable mode "
                                   f"{kind} = {_fmt(lam)} is uncontrollable from the controls u")
-        M = np.vstack([A - lam * np.eye(n), C2])
+    T11, C2u = _unstable_block(A.T, C2.T, P.dt)  # (C2, A) by duality
+    for lam in np.linalg.eigvals(T11):
+        M = np.hstack([T11 - lam * np.eye(T11.shape[0]), C2u])
         if np.linalg.svd(M, compute_uv=False)[-1] <= PBH_TOL * scale_c:
             raise InfeasibleError(f"(C2, A) is not detectable: the unstable mode "
-                                  f"{kind} = {_fmt(lam)} is unobservable from the measurements y")
+                                  f"{kind} = {_fmt(np.conj(lam))} is unobservable from the "
+                                  f"measurements y")
+
+
+def _unstable_block(A: np.ndarray, B: np.ndarray, dt: float):
+    """``(T22, B_u)``: the unstable block of a complex Schur form of ``A`` with the stable
+    modes first (``Q* A Q = [[T11, T12], [0, T22]]``) and the rows of ``Q* B`` that
+    drive it.  The unstable modes of ``(A, B)`` are controllable iff they are of
+    ``(T22, B_u)`` (a left eigenvector of ``A`` for an eigenvalue of ``T22`` is ``[0, w]``)."""
+    from scipy.linalg import schur
+
+    if dt:
+        def stable(x):
+            return np.abs(x) < 1.0 - 1e-12
+    else:
+        def stable(x):
+            return np.real(x) < -1e-12 * np.maximum(1.0, np.abs(x))
+    T, Q, k = schur(np.asarray(A, dtype=complex), output="complex", sort=stable)
+    return T[k:, k:], (Q.conj().T @ np.asarray(B, dtype=complex))[k:]
 
 
 def _fmt(lam: complex) -> str:
