@@ -32,6 +32,7 @@ from bench_hinfsyn import plant  # noqa: E402
 OPTS = HinfsynOptions()
 #: the factorisation the injections wrap (captured once: an injection may replace another)
 _CHO_FACTOR = structured.scipy.linalg.cho_factor
+_CHO_SOLVE = structured.scipy.linalg.cho_solve
 
 
 def _problem(P, sparse=True):
@@ -576,3 +577,42 @@ def test_the_trace_multiplier_bounds_the_optimums_slope_in_the_trace_bound():
     assert mid.gamma > free.gamma * (1 + 1e-6)                    # the bound is active
     assert (mid.gamma - wide.gamma - slack) / b <= mid.trace_multiplier
     assert mid.trace_multiplier <= (narrow.gamma - mid.gamma + slack) / (b / 2)
+
+
+def test_add_pairs_is_the_sum_of_traces_of_the_basis_products():
+    """``_Basis.add_pairs`` (batched outer products, one gather) against its definition
+    ``out[i, j] += sum_k c_k tr(E_i P_k E_j Q_k)`` evaluated term by term, on
+    non-symmetric ``P_k``, ``Q_k`` (as ``(Vᵀ U, Vᵀ U)`` of an inequality) and a symmetric
+    pair (the coupling's)."""
+    n = 4
+    rng = np.random.default_rng(64)
+    basis = structured._Basis(n)
+    S = rng.standard_normal((n, n))
+    pairs = [(rng.standard_normal((n, n)), rng.standard_normal((n, n)), 2.0),
+             (S + S.T, S + S.T, 1.0)]
+    out = np.ones((basis.size, basis.size))
+    basis.add_pairs(out, pairs)
+    E = [basis.matrix(np.eye(basis.size)[i]) for i in range(basis.size)]
+    want = 1.0 + np.array([[sum(c * np.trace(Ei @ P @ Ej @ Q) for P, Q, c in pairs)
+                            for Ej in E] for Ei in E])
+    assert np.allclose(out, want, rtol=1e-13, atol=1e-13 * np.abs(want).max())
+
+
+def test_a_negligible_refinement_step_ends_the_refinement(small, monkeypatch):
+    """``_REFINEMENT_FLOOR``: with the exact factor of a well-conditioned complement a
+    refinement step moves the solution by less than 1e-12 (relative) before the last
+    of ``_REFINEMENT_STEPS`` (here the second: three solves, measured 2026-12-02), and
+    the refinement ends there -- with the KKT equations satisfied as with all steps."""
+    prob, _ = small
+    solves = []
+
+    def counted(*args, **kw):
+        solves.append(1)
+        return _CHO_SOLVE(*args, **kw)
+
+    monkeypatch.setattr(structured.scipy.linalg, "cho_solve", counted)
+    W = _random_scaling(prob, np.random.default_rng(3))
+    f = prob.kktsolver(W)
+    rx, rz = _kkt_residuals(prob, W, f, np.random.default_rng(4))
+    assert rx < 1e-8 and rz < 1e-8
+    assert len(solves) < 1 + structured._REFINEMENT_STEPS
