@@ -1218,8 +1218,13 @@ def test_order_judgement_agrees_with_mu_on_the_whole_grid():
             peaks.append(float(np.max(_final_bounds(CL_red, struct, w,
                                                     np.random.default_rng(0)).upper)))
     verdicts = []
-    # the search's limit, and one between the truncations' own peaks
-    for limit in (1.01 * float(np.max(full.upper)), float(np.median(peaks))):
+    # the search's limit, and one in the widest gap between the truncations' own peaks
+    # (several truncations share a peak to the last digits: a limit at or near one would
+    # leave the verdict to roundoff)
+    ranked = np.sort(peaks)
+    gap = int(np.argmax(ranked[1:] / ranked[:-1]))
+    for limit in (1.01 * float(np.max(full.upper)),
+                  float(np.sqrt(ranked[gap] * ranked[gap + 1]))):
         for CL_red, peak in zip(loops, peaks):
             judged = _within(CL_red, struct, full, w, limit, np.random.default_rng(0))
             assert judged == (peak <= limit), (limit, peak)
