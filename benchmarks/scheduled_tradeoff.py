@@ -27,7 +27,10 @@ the first round's seats the bin's nominal seat and the corners of ``m3``, ``k1``
 each next round from the last controller with the seats where the round's search
 (:func:`~lmi_suspension.seat.worstcase.worst_bump_seats` over the corners of the subset
 and a climb) found the force or the stroke above its bound added as design seats, as
-``seat/data/mu_occupants.json`` was made (its metadata's ``made``); at most
+``seat/data/mu_occupants.json`` was made (its metadata's ``made``), together with the
+:data:`ADD_CORNERS` corners of the subset's box that command the most force above the
+bound (:func:`_force_corners`; ``--add-corners 0``: the searched seat alone, as ``a`` at
+1500 N's rounds 2 and 3 were made, one corner a round); at most
 :data:`ROUNDS` rounds, fewer when a round's search finds no violation.  The first round
 of ``a`` at 1500 N is the shipped ``mu_scheduled.json``'s bin 40-50 (the same subset,
 options, seed and start; ``--from-shipped`` reuses it, ``--fresh`` designs it again).
@@ -95,6 +98,9 @@ DEFAULT_POINTS = ("a:1500", "c:1500", "d:1500", "a:2000", "c:2000", "b:1500", "d
                   "b:2000")
 #: the budget of one round (benchmarks/scheduled_tuned.py's) and the rounds of a point
 MAX_ITER, N_SEARCH, ROUNDS = 40, 10, 3
+#: besides the searched seat, the corners above the force bound that join a round's
+#: design seats (the most force first)
+ADD_CORNERS = 3
 DESIGN_SEED, SAMPLE_SEED, SEARCH_SEED = 7, 62, 11
 N_STABILITY, N_PERFORMANCE, SEARCH_N = 100, 24, 10
 
@@ -127,7 +133,8 @@ def _late(stop_at) -> bool:
 
 
 def design_point(key: str, u: float, work: Path, *, rounds: int = ROUNDS,
-                 from_shipped: bool = True, stop_at=None, log=print) -> dict:
+                 from_shipped: bool = True, stop_at=None, add_corners: int = ADD_CORNERS,
+                 log=print) -> dict:
     """The rounds of one point (see the module docstring); each round kept under
     ``work`` and reused.  Returns ``{"rounds": [...], "K": last controller or None,
     "held": bool}``."""
@@ -191,10 +198,15 @@ def design_point(key: str, u: float, work: Path, *, rounds: int = ROUNDS,
                 f"{rec['u_design']:.0f} N; searched {rec['searched']}")
         records.append(rec)
         plants = [_seat(p) for p in rec["plants"]]
-        # the seats the round's search found above a bound join the design seats
+        # the seats the round's search found above a bound join the design seats, and
+        # the corners of the subset that command the most force above it (a round adds
+        # one searched seat only, and the next round's search finds the next corner)
         added = [_seat(s["seat"]) for s in rec["searched"].values()
                  if s["frequency_value"] > (u if s["figure"] == "u" else 0.08)]
-        added = [p for p in added if p not in plants and p != subset.nominal]
+        if added and add_corners:
+            added += _force_corners(K, subset, u, add_corners)
+        added = list(dict.fromkeys(p for p in added
+                                   if p not in plants and p != subset.nominal))
         if not added:
             break
         plants = plants + added
@@ -202,6 +214,27 @@ def design_point(key: str, u: float, work: Path, *, rounds: int = ROUNDS,
         s["frequency_value"] <= (u if s["figure"] == "u" else 0.08)
         for s in records[-1]["searched"].values())
     return {"rounds": records, "K": K if records else None, "held_in_design_search": held}
+
+
+def _force_corners(K, subset, u: float, count: int) -> list:
+    """The ``count`` corners of ``subset``'s box (every parameter with a range at an
+    end, the others at their value) where ``K`` commands the most force above ``u`` at
+    one of the delays 0-25 ms (frequency-domain figure; corners where the loop is
+    unstable without delay are left out)."""
+    from itertools import product
+
+    from lmi_suspension.seat.loop import REFINE_DELAYS, BumpResponse, loop_poles
+
+    ranges = [(n, lo, hi) for n, lo, hi in subset.ranges() if hi > lo]
+    found = []
+    for ends in product(*((lo, hi) for _, lo, hi in ranges)):
+        p = subset.at({n: v for (n, _, _), v in zip(ranges, ends)})
+        if np.max(loop_poles(K, p).real) >= 0:
+            continue
+        peak = float(np.max(BumpResponse(delays=REFINE_DELAYS, params=p).peaks(K)[1]))
+        if peak > u:
+            found.append((peak, p))
+    return [p for _, p in sorted(found, key=lambda f: -f[0])[:count]]
 
 
 def _searched(*seats) -> dict:
@@ -315,8 +348,13 @@ def main(argv=None):
     ap.add_argument("--stop-at", default=None, help="HH:MM UTC: start no round after it")
     ap.add_argument("--measure-only", action="store_true",
                     help="design nothing: measure the rounds kept under --work")
+    ap.add_argument("--round", type=int, default=None,
+                    help="with --measure-only: measure this round of each point, not its "
+                         "last (round 1 holds the bound at its design seats only)")
     ap.add_argument("--fresh", action="store_true",
                     help="design a:1500's first round instead of reusing the shipped bin")
+    ap.add_argument("--add-corners", type=int, default=ADD_CORNERS,
+                    help="corners above the bound added per round besides the searched seat")
     ap.add_argument("--figure", default=None, help="write the PNG figure here")
     args = ap.parse_args(argv)
     stop_at = None
@@ -334,9 +372,11 @@ def main(argv=None):
         print(f"point {key} ({KNOWLEDGE[key][0]}), U = {u:g} N", flush=True)
         d = design_point(key, u, work, rounds=0 if args.measure_only else args.rounds,
                          from_shipped=not args.fresh, stop_at=stop_at,
+                         add_corners=args.add_corners,
                          log=lambda s: print(s, flush=True)) if not args.measure_only \
-            else _kept(key, u, work, args.rounds)
+            else _kept(key, u, work, args.round)
         p = {"key": key, "label": KNOWLEDGE[key][0], "u_bound": u, "rounds": d["rounds"],
+             "round_measured": len(d["rounds"]),
              "subset": {n: [lo, hi] for n, lo, hi in subset_of(key).ranges()}}
         if d["K"] is not None:
             p["measured"] = measure(d["K"], key, limits_cache)
@@ -360,12 +400,13 @@ def main(argv=None):
         figure(points, Path(args.figure))
 
 
-def _kept(key, u, work: Path, rounds: int) -> dict:
-    """The last round kept under ``work`` for a point (``--measure-only``)."""
+def _kept(key, u, work: Path, last: int | None = None) -> dict:
+    """The rounds kept under ``work`` for a point up to ``last`` (all by default), and
+    the last one's controller (``--measure-only``)."""
     from lmi_suspension.io import load_controller
 
     records, K = [], None
-    for index in range(1, max(rounds, 1) + 10):
+    for index in range(1, (last or 99) + 1):
         part = _part(work, key, u, index)
         if not part.exists():
             break
