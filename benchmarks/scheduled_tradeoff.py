@@ -296,40 +296,45 @@ def table(points: list) -> str:
     return "\n".join(lines)
 
 
+def _series(p) -> str:
+    """The line a measured point belongs to: its force bound, and whether it is the
+    first round (the bound held at the design seats only) or the last."""
+    if p.get("round_measured", len(p["rounds"])) == 1 and len(p["rounds"]) == 1 \
+            and p["measured"]["u_searched"] > p["u_bound"]:
+        return f"U = {p['u_bound']:g} N at the design seats only (round 1)"
+    return f"U = {p['u_bound']:g} N, searched seats added (last round)"
+
+
 def figure(points: list, path: Path):
     """Nominal and worst ratio of each measured point against what the seat knows, one
-    line per force bound, the targets dashed."""
+    line per force bound and round, the targets dashed, each point labelled by the
+    searched force."""
     import matplotlib.pyplot as plt
 
     keys = list(KNOWLEDGE)
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6), sharey=True)
+    measured = [p for p in points if p.get("measured") is not None]
+    series = list(dict.fromkeys(_series(p) for p in measured))
+    fig, axes = plt.subplots(1, 2, figsize=(9.5, 4.0), sharey=True)
     for ax, what, target in ((axes[0], "nominal_ratio", 1.5), (axes[1], "worst_ratio", 1.8)):
-        for u, marker in zip(U_BOUNDS, "os"):
-            xs, ys, labels = [], [], []
-            for p in points:
-                m = p.get("measured")
-                if m is None or p["u_bound"] != u:
-                    continue
-                xs.append(keys.index(p["key"]))
-                ys.append(m[what])
-                labels.append(f"{m['u_searched']:.0f} N")
-            if xs:
-                order = np.argsort(xs)
-                ax.plot(np.array(xs)[order], np.array(ys)[order], marker=marker,
-                        label=f"U = {u:g} N held")
-                for x, y, t in zip(xs, ys, labels):
-                    ax.annotate(t, (x, y), textcoords="offset points", xytext=(4, 4),
-                                fontsize=7)
+        for name, marker in zip(series, "osD^v"):
+            pts = sorted((keys.index(p["key"]), p["measured"][what],
+                          p["measured"]["u_searched"]) for p in measured
+                         if _series(p) == name)
+            xs, ys, us = zip(*pts)
+            ax.plot(xs, ys, marker=marker, label=name)
+            for x, y, uu in pts:
+                ax.annotate(f"{uu:.0f} N", (x, y), textcoords="offset points",
+                            xytext=(4, 4), fontsize=7)
         ax.axhline(target, ls="--", c="k", lw=0.8)
         ax.set_xticks(range(len(keys)))
         ax.set_xticklabels([KNOWLEDGE[k][0].replace(", ", "\n") for k in keys], fontsize=7)
         ax.set_title(("nominal seat" if what == "nominal_ratio" else "worst seat")
-                     + f" / own limit (target {target})", fontsize=9)
+                     + f" / own limit (target {target}, dashed)", fontsize=9)
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("peak |z̈3| / clairvoyant limit")
-    axes[1].legend(fontsize=8)
-    fig.suptitle("Bin of estimated mass 40-50 kg: what the seat knows vs the force bound "
-                 "(labels: searched |u|)", fontsize=9)
+    axes[1].legend(fontsize=7)
+    fig.suptitle("Bin of estimated mass 40-50 kg: what the seat knows against the force "
+                 "bound (labels: |u| the search finds)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
@@ -356,6 +361,9 @@ def main(argv=None):
     ap.add_argument("--add-corners", type=int, default=ADD_CORNERS,
                     help="corners above the bound added per round besides the searched seat")
     ap.add_argument("--figure", default=None, help="write the PNG figure here")
+    ap.add_argument("--with-json", nargs="*", default=None,
+                    help="with --figure: the points of these result files too (e.g. the "
+                         "first rounds measured by --measure-only --round 1)")
     args = ap.parse_args(argv)
     stop_at = None
     if args.stop_at:
@@ -397,6 +405,8 @@ def main(argv=None):
         Path(args.json).write_text(json.dumps(out, indent=1))
     print("\n" + table(points))
     if args.figure:
+        for extra in args.with_json or ():
+            points = points + json.loads(Path(extra).read_text())["points"]
         figure(points, Path(args.figure))
 
 
