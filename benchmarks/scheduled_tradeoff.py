@@ -54,11 +54,16 @@ under ``nice``)::
     python benchmarks/scheduled_tradeoff.py                       # the default points
     python benchmarks/scheduled_tradeoff.py --points a:1500,c:1500 --stop-at 16:50
     python benchmarks/scheduled_tradeoff.py --measure-only        # the kept designs
-    python benchmarks/scheduled_tradeoff.py --figure docs/scheduled_tradeoff.png
+    python benchmarks/scheduled_tradeoff.py --measure-only --round 1 --points a:1500 \
+        --json /tmp/a1.json                                       # an earlier round
+    python benchmarks/scheduled_tradeoff.py --measure-only --points a:1500,c:1500 \
+        --with-json /tmp/a1.json --figure docs/gallery/scheduled_tradeoff.png
 
-Budget: one round is about 450-700 s of CPU (more seats, more time), a point 1-3
-rounds, the measurement of a point about 100 s; the default points in their priority
-order take 2-4 h of CPU on one core.  ``--stop-at HH:MM`` (UTC) starts no new round
+Budget (measured 2026-12-02 on the shared 2-core machine at load 4-6, process CPU
+time): one round 195-315 s of CPU (5-11 design seats; the SLSQP stops before its 40
+iterations), a point 1-5 rounds, the measurement of a point about 25 s (the 24 seats'
+limits about 17 s more, once per point); the default points in their priority order
+take 1-2 h of CPU on one core.  ``--stop-at HH:MM`` (UTC) starts no new round
 after that time; the points not designed are reported as such.  Results go to
 ``--json`` (default ``benchmarks/results/scheduled_tradeoff.json``): per point its
 rounds (design seats, the search's figures, CPU seconds) and the measurement.
@@ -296,45 +301,35 @@ def table(points: list) -> str:
     return "\n".join(lines)
 
 
-def _series(p) -> str:
-    """The line a measured point belongs to: its force bound, and whether it is the
-    first round (the bound held at the design seats only) or the last."""
-    if p.get("round_measured", len(p["rounds"])) == 1 and len(p["rounds"]) == 1 \
-            and p["measured"]["u_searched"] > p["u_bound"]:
-        return f"U = {p['u_bound']:g} N at the design seats only (round 1)"
-    return f"U = {p['u_bound']:g} N, searched seats added (last round)"
-
-
 def figure(points: list, path: Path):
-    """Nominal and worst ratio of each measured point against what the seat knows, one
-    line per force bound and round, the targets dashed, each point labelled by the
-    searched force."""
+    """The trade-off: nominal and worst ratio of each measured design against the force
+    the search finds at it, one line per state of knowledge (its rounds: each adds the
+    searched seats), the targets and 1500 N dashed."""
     import matplotlib.pyplot as plt
 
-    keys = list(KNOWLEDGE)
     measured = [p for p in points if p.get("measured") is not None]
-    series = list(dict.fromkeys(_series(p) for p in measured))
     fig, axes = plt.subplots(1, 2, figsize=(9.5, 4.0), sharey=True)
     for ax, what, target in ((axes[0], "nominal_ratio", 1.5), (axes[1], "worst_ratio", 1.8)):
-        for name, marker in zip(series, "osD^v"):
-            pts = sorted((keys.index(p["key"]), p["measured"][what],
-                          p["measured"]["u_searched"]) for p in measured
-                         if _series(p) == name)
-            xs, ys, us = zip(*pts)
-            ax.plot(xs, ys, marker=marker, label=name)
-            for x, y, uu in pts:
-                ax.annotate(f"{uu:.0f} N", (x, y), textcoords="offset points",
-                            xytext=(4, 4), fontsize=7)
+        for key, marker in zip(KNOWLEDGE, "osD^"):
+            pts = sorted({(p["measured"]["u_searched"], p["measured"][what],
+                           len(p["rounds"])) for p in measured if p["key"] == key})
+            if not pts:
+                continue
+            us, ys, rs = zip(*pts)
+            ax.plot(us, ys, marker=marker, label=f"({key}) {KNOWLEDGE[key][0]}")
+            for x, y, r in pts:
+                ax.annotate(f"r{r}", (x, y), textcoords="offset points", xytext=(3, 3),
+                            fontsize=7)
         ax.axhline(target, ls="--", c="k", lw=0.8)
-        ax.set_xticks(range(len(keys)))
-        ax.set_xticklabels([KNOWLEDGE[k][0].replace(", ", "\n") for k in keys], fontsize=7)
-        ax.set_title(("nominal seat" if what == "nominal_ratio" else "worst seat")
-                     + f" / own limit (target {target}, dashed)", fontsize=9)
+        ax.axvline(1500.0, ls=":", c="r", lw=0.8)
+        ax.set_xlabel("largest |u| the worst-seat search finds (N)")
+        ax.set_title(("nominal seat" if what == "nominal_ratio" else "worst of 24 seats")
+                     + f" / own limit (target {target})", fontsize=9)
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("peak |z̈3| / clairvoyant limit")
     axes[1].legend(fontsize=7)
-    fig.suptitle("Bin of estimated mass 40-50 kg: what the seat knows against the force "
-                 "bound (labels: |u| the search finds)", fontsize=9)
+    fig.suptitle("Bin of estimated mass 40-50 kg: comfort against the force held at the "
+                 "searched seats (rN: round N)", fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=90)
     plt.close(fig)
@@ -362,8 +357,9 @@ def main(argv=None):
                     help="corners above the bound added per round besides the searched seat")
     ap.add_argument("--figure", default=None, help="write the PNG figure here")
     ap.add_argument("--with-json", nargs="*", default=None,
-                    help="with --figure: the points of these result files too (e.g. the "
-                         "first rounds measured by --measure-only --round 1)")
+                    help="the points of these result files (e.g. earlier rounds measured "
+                         "by --measure-only --round N) join the figure and --json's "
+                         "'other_rounds'")
     args = ap.parse_args(argv)
     stop_at = None
     if args.stop_at:
@@ -403,11 +399,18 @@ def main(argv=None):
                "points": points}
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)
         Path(args.json).write_text(json.dumps(out, indent=1))
+    others = [q for extra in args.with_json or ()
+              for q in json.loads(Path(extra).read_text())["points"]]
+    if others:
+        # the other rounds' measurements join the result file (the curve along the
+        # force the search finds) and the figure
+        out["other_rounds"] = others
+        Path(args.json).write_text(json.dumps(out, indent=1))
     print("\n" + table(points))
+    if others:
+        print("\nother rounds:\n" + table(others))
     if args.figure:
-        for extra in args.with_json or ():
-            points = points + json.loads(Path(extra).read_text())["points"]
-        figure(points, Path(args.figure))
+        figure(points + others, Path(args.figure))
 
 
 def _kept(key, u, work: Path, last: int | None = None) -> dict:
