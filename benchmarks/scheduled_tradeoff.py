@@ -65,7 +65,7 @@ iterations), a point 1-5 rounds, the measurement of a point about 25 s (the 24 s
 limits about 17 s more, once per point); the default points in their priority order
 take 1-2 h of CPU on one core.  ``--stop-at HH:MM`` (UTC) starts no new round
 after that time; the points not designed are reported as such.  Results go to
-``--json`` (default ``benchmarks/results/scheduled_tradeoff.json``): per point its
+``--json`` (default ``benchmarks/scheduled_tradeoff.json``): per point its
 rounds (design seats, the search's figures, CPU seconds) and the measurement.
 """
 
@@ -343,8 +343,8 @@ def main(argv=None):
     ap.add_argument("--rounds", type=int, default=ROUNDS)
     ap.add_argument("--work", default="/tmp/scheduled_tradeoff",
                     help="where each round's controller is kept (and reused)")
-    ap.add_argument("--json", default=str(ROOT / "benchmarks" / "results" /
-                                          "scheduled_tradeoff.json"))
+    # not benchmarks/results/: benchmarks/current.py reads every file there as a run
+    ap.add_argument("--json", default=str(ROOT / "benchmarks" / "scheduled_tradeoff.json"))
     ap.add_argument("--stop-at", default=None, help="HH:MM UTC: start no round after it")
     ap.add_argument("--measure-only", action="store_true",
                     help="design nothing: measure the rounds kept under --work")
