@@ -9,6 +9,16 @@ Run (from the repository root, ``MPLBACKEND=Agg OPENBLAS_NUM_THREADS=1 PYTHONPAT
     python benchmarks/scheduled_tuned.py --design        # design the table anew, then compare
     python benchmarks/scheduled_tuned.py --quick         # 8 seats, 50 stability samples, no µ
     python benchmarks/scheduled_tuned.py --certify       # item 3's certificate of the table
+    python benchmarks/scheduled_tuned.py --hold-force --bins 30-40 --out DIR
+                                      # more rounds from the shipped bin: the force found
+
+``--hold-force`` (:func:`hold_force`) starts from ``--start``'s table (the shipped one by
+default) and gives the bins of ``--bins`` more rounds, warm started, each adding as
+design seats the seat where the certificate's search (``worst_bump_seats``, 50 samples)
+finds the force above 1500 N and the worst corners of the bin's box above it, until the
+search finds at most 1500 N and 0.08 m (at most ``--hold-rounds`` rounds of
+``--hold-iter`` iterations); it writes ``--out``'s ``mu_scheduled.json`` with those bins
+replaced, their rounds under ``bins[i]["hold_force"]``, and drops the certificate.
 
 ``--design`` writes ``--out`` (default ``lmi_suspension/seat/data``) ``mu_scheduled.json``
 and ``mu_at_mass.json``; ``--jobs 2`` designs two bins at a time (the machine has two
