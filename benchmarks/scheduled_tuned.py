@@ -369,8 +369,9 @@ def hold_force(start: Path, out: Path, *, bins, max_iter: int, rounds: int,
                search_n: int, u_bound: float, jobs: int = 1):
     """:func:`_hold` for each bin of ``bins``; writes ``out/mu_scheduled.json``: the
     start table with those bins replaced, their figures under ``bins[i]["hold_force"]``
-    (a later run with other bins keeps the ones held already, from ``out`` if it is
-    there)."""
+    (to go on with other bins, start from that table; the rounds kept under
+    ``out/parts`` are named by bin and round only, so another start wants another
+    ``out``)."""
     from lmi_suspension.io import (controller_from_dict, load_controller,
                                    save_scheduled_controller)
     from lmi_suspension.lti.gridded import GriddedController
@@ -381,9 +382,7 @@ def hold_force(start: Path, out: Path, *, bins, max_iter: int, rounds: int,
             done = list(pool.map(_hold, work))
     else:
         done = [_hold(w) for w in work]
-    # the table to update: out's own if an earlier run wrote it there, else the start
-    base = out / "mu_scheduled.json"
-    Ks, meta = load_controller(base if base.exists() else start)
+    Ks, meta = load_controller(start)
     meta = dict(meta)
     rows = [dict(r) for r in meta["bins"]]
     Kbins = [Ks.at(m3=(r["estimates"][0] + r["estimates"][1]) / 2) for r in rows]
