@@ -318,8 +318,9 @@ def test_mixed_dgk_on_a_discrete_plant():
 
     ex, dt = stiffness_oscillator(), 0.05
     cont, disc = _musyn_pair(ex.P, ex.blk, np.logspace(-2, 2, 40),
-                             MusynOptions(max_iter=3, complexify=False), dt)
+                             MusynOptions(max_iter=3, complexify=False, reduce_order=None), dt)
     _assert_discrete_certified(disc, ex.blk, dt)
+    # full order: each run's own order reduction would pick its own order and µ within 1 %
     assert disc.mu_peak == pytest.approx(cont.mu_peak, rel=5e-3)
     assert disc.mu_peak < 1.131  # below the complexified design (measured 1.1309)
 
