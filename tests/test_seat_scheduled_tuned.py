@@ -85,7 +85,8 @@ def test_references_stable_at_their_masses(at_mass):
             assert all(closed_loop_stable(K, d, p) for d in (0.0, 0.025))
 
 
-@pytest.mark.parametrize("name", ["mu_scheduled.json", "mu_at_mass.json"])
+@pytest.mark.parametrize("name", ["mu_scheduled.json", "mu_at_mass.json",
+                                  "mu_scheduled_u1500.json"])
 def test_file_round_trip_bit_for_bit(tmp_path, name):
     K, meta = load_controller(DATA / name)
     again = save_scheduled_controller(tmp_path / name, K, metadata=meta)
