@@ -268,11 +268,44 @@ def _force_corners(K, subset, threshold: float, most: int):
     return sorted(found, key=lambda f: -f[0])[:most]
 
 
+def _hold_subset(kind, where):
+    """The set a hold-force job serves: a bin's (true mass within ``ERROR`` of its
+    estimates) or a reference's (the mass exactly), everything else the set's; and the
+    scheduling value its start controller is read at."""
+    from lmi_suspension.seat.occupant_subset import OccupantSubset
+    from lmi_suspension.seat.occupants import OccupantSet
+    from lmi_suspension.seat.scheduled import scheduling_subset
+
+    if kind == "bin":
+        a, b = where
+        return scheduling_subset(OccupantSet(), (a, b), ERROR), (a + b) / 2
+    m = float(where)
+    return OccupantSubset(nominal=replace(OccupantSet().nominal, m3=m), m3=(m, m)), m
+
+
+def _held_seats(meta, kind, where, subset):
+    """The design seats earlier hold-force rounds added to the start's bin or
+    reference (its ``hold_force`` history in the file's metadata), in their order."""
+    rows = meta.get("bins" if kind == "bin" else "nodes", []) if meta else []
+    match = (lambda r: tuple(r["estimates"]) == tuple(where)) if kind == "bin" else (
+        lambda r: float(r["m3"]) == float(where))
+    row = next((r for r in rows if match(r)), {})
+    seats = []
+    for rnd in row.get("hold_force", {}).get("history", []):
+        for found in rnd.get("added", []) + rnd.get("corners_added", []):
+            seats.append(replace(subset.nominal, **found["seat"]))
+    return seats
+
+
 def _hold(job):
-    """One bin's hold-force rounds: ``job = (bin, start file, max_iter, rounds,
-    search_n, u_bound, out)``.  From the start file's controller of the bin (warm
-    start) and its design seats (the bin's nominal seat and the corners of ``m3``,
-    ``k1``, :func:`_options`): search the bin's set (:func:`worst_bump_seats`, as the
+    """One bin's (or reference's) hold-force rounds: ``job = (kind, where, start file,
+    max_iter, rounds, search_n, u_bound, out, disk_radius)``, ``kind`` ``"bin"``
+    (``where`` its estimates) or ``"ref"`` (``where`` the mass of a reference of
+    ``mu_at_mass.json``: the same rounds make the reference hold the force at the seats
+    the search finds, so that a schedule held to it is compared with references held to
+    it too).  From the start file's controller there (warm start) and its design seats
+    (the nominal seat and the corners of ``m3``, ``k1``, :func:`_options`; a reference
+    has the corners of ``k1``): search the set (:func:`worst_bump_seats`, as the
     certificate does, ``search_n`` samples, seed ``[HOLD_SEED, round]``); if the force
     or the stroke found exceeds :data:`HOLD_U` / :data:`HOLD_X1`, add the seat found as a
     design seat and refine once more (``refine_seat_controller`` with the occupant
@@ -282,18 +315,22 @@ def _hold(job):
     refinements.  Each refinement is kept under ``out/parts`` (a later run resumes from
     there); returns ``(bin, K as dict, figures)``."""
     from lmi_suspension.io import controller_to_dict, load_controller, save_controller
-    from lmi_suspension.seat.occupants import OccupantSet
     from lmi_suspension.seat.refine import refine_seat_controller
-    from lmi_suspension.seat.scheduled import scheduling_subset
+    from lmi_suspension.seat.sampled import fastest_pole
     from lmi_suspension.seat.worstcase import worst_bump_seats
 
-    where, start, max_iter, rounds, search_n, u_bound, out = job
-    a, b = where
-    Ks, _ = load_controller(start)
-    K = Ks.at(m3=(a + b) / 2)
-    subset = scheduling_subset(OccupantSet(), (a, b), ERROR)
+    kind, where, start, max_iter, rounds, search_n, u_bound, out, disk_radius = job
+    subset, at = _hold_subset(kind, where)
+    name = f"{where[0]:g}-{where[1]:g}" if kind == "bin" else f"ref_{float(where):g}"
+    Ks, meta = load_controller(start)
+    K = Ks.at(m3=at)
     opts = _options(subset, max_iter, u_bound)
-    plants = list(opts.plants)
+    if disk_radius is not None:
+        opts = replace(opts, disk_radius=float(disk_radius))
+    # a start that was held already keeps the design seats its rounds added: without
+    # them a further round (a smaller disk) lost the force held (60-70 kg bin, disk
+    # 1000 rad/s from 5 seats: 1652 N searched after one round, 2026-12-02)
+    plants = list(dict.fromkeys(list(opts.plants) + _held_seats(meta, kind, where, subset)))
     history, held, why = [], False, "rounds"
     cpu0, wall0 = time.process_time(), time.perf_counter()
     for k in range(rounds + 1):
@@ -309,10 +346,13 @@ def _hold(job):
         else:
             history.append({"round": 0, "design_seats": len(plants) + 1,
                             "search_after": search})
-        print(f"  bin {a:g}-{b:g} after round {k}: searched |u| {u.value:.1f} N, |x1| "
+        print(f"  {kind} {name} after round {k}: searched |u| {u.value:.1f} N, |x1| "
               f"{x1.value:.4f} m, bin-nominal ratio {search['bin_nominal_ratio']:.3f} "
               f"({search['search_cpu_seconds']:.0f} s CPU)", flush=True)
-        if u.value <= HOLD_U and x1.value <= HOLD_X1:
+        # a controller with a pole outside a given disk gets a round even where the
+        # force is held: the round residualises it to the disk (the 1 kHz loop's fidelity)
+        outside = disk_radius is not None and fastest_pole(K) > disk_radius
+        if u.value <= HOLD_U and x1.value <= HOLD_X1 and not outside:
             held, why = True, "held"
             break
         if k == rounds:
@@ -321,15 +361,16 @@ def _hold(job):
         corners = _force_corners(K, subset, HOLD_NEAR * HOLD_U, HOLD_ADD)
         added = [p for p in dict.fromkeys(added + [p for _, p in corners])
                  if p not in plants and p != subset.nominal]
-        if not added:
+        if not added and not outside:
             why = "the seats found are design seats already"
             break
         plants += added
-        part = out / "parts" / f"hold_{a:g}-{b:g}_r{k + 1}.json"
+        radius = "" if disk_radius is None else f"_d{float(disk_radius):g}"
+        part = out / "parts" / f"hold_{name}{radius}_r{k + 1}.json"
         c, t = time.process_time(), time.perf_counter()
         if part.exists():
             K, fig = load_controller(part)
-            print(f"  bin {a:g}-{b:g} round {k + 1}: reused {part}", flush=True)
+            print(f"  {kind} {name} round {k + 1}: reused {part}", flush=True)
         else:
             d = refine_seat_controller(K, replace(opts, plants=tuple(plants)),
                                        params=subset.nominal)
@@ -345,12 +386,13 @@ def _hold(job):
                    "u_at_design_seats": float(np.max(d.u_peak)),
                    "x1_at_design_seats": float(np.max(d.x1_peak)),
                    "rs_sup": float(d.rs_sup), "radius": float(d.radius),
+                   "disk_radius": float(opts.disk_radius),
                    "cpu_seconds": time.process_time() - c,
                    "seconds": time.perf_counter() - t}
             part.parent.mkdir(parents=True, exist_ok=True)
             save_controller(part, K, inputs=["x1", "x3"], outputs=["u"], metadata=fig)
         fig = dict(fig)
-        print(f"  bin {a:g}-{b:g} round {k + 1}: {fig['design_seats']} seats, ratio "
+        print(f"  {kind} {name} round {k + 1}: {fig['design_seats']} seats, ratio "
               f"{fig['peak_over_limit_at_design_seats']:.3f} at them, |u| "
               f"{fig['u_at_design_seats']:.0f} N, met {fig['met']} "
               f"({fig['cpu_seconds']:.0f} s CPU)", flush=True)
@@ -362,54 +404,83 @@ def _hold(job):
                             "x1": history[-1]["search_after"]["x1"]},
                "true_m3": list(subset.m3), "states": int(K.nstates),
                "design_seats": len(plants) + 1, "history": history}
-    return where, controller_to_dict(K, inputs=["x1", "x3"], outputs=["u"]), figures
+    return kind, where, controller_to_dict(K, inputs=["x1", "x3"], outputs=["u"]), figures
 
 
 def hold_force(start: Path, out: Path, *, bins, max_iter: int, rounds: int,
-               search_n: int, u_bound: float, jobs: int = 1):
-    """:func:`_hold` for each bin of ``bins``; writes ``out/mu_scheduled.json``: the
-    start table with those bins replaced, their figures under ``bins[i]["hold_force"]``
-    (to go on with other bins, start from that table; the rounds kept under
-    ``out/parts`` are named by bin and round only, so another start wants another
-    ``out``)."""
+               search_n: int, u_bound: float, jobs: int = 1, disk_radius=None,
+               refs=(), ref_start: Path | None = None):
+    """:func:`_hold` for each bin of ``bins`` (from ``start``'s table) and each mass of
+    ``refs`` (from ``ref_start``'s references); writes ``out/mu_scheduled.json``, the
+    start table with those bins replaced and their figures under
+    ``bins[i]["hold_force"]``, and with ``refs`` ``out/mu_at_mass.json`` likewise (to go
+    on with other bins, start from that table; the rounds kept under ``out/parts`` are
+    named by bin, disk and round only, so another start wants another ``out``)."""
     from lmi_suspension.io import (controller_from_dict, load_controller,
                                    save_scheduled_controller)
     from lmi_suspension.lti.gridded import GriddedController
 
-    work = [(tuple(w), str(start), max_iter, rounds, search_n, u_bound, out) for w in bins]
+    ref_start = DATA / "mu_at_mass.json" if ref_start is None else Path(ref_start)
+    work = [("bin", tuple(w), str(start), max_iter, rounds, search_n, u_bound, out,
+             disk_radius) for w in bins]
+    work += [("ref", float(m), str(ref_start), max_iter, rounds, search_n, u_bound, out,
+              disk_radius) for m in refs]
     if jobs > 1:
         with ProcessPoolExecutor(jobs) as pool:
             done = list(pool.map(_hold, work))
     else:
         done = [_hold(w) for w in work]
-    Ks, meta = load_controller(start)
-    meta = dict(meta)
-    rows = [dict(r) for r in meta["bins"]]
-    Kbins = [Ks.at(m3=(r["estimates"][0] + r["estimates"][1]) / 2) for r in rows]
-    for where, Kd, fig in done:
-        i = next(j for j, r in enumerate(rows) if tuple(r["estimates"]) == tuple(where))
-        Kbins[i] = controller_from_dict(Kd)
-        rows[i]["hold_force"] = fig
-        rows[i]["searched"] = fig["searched"]
-        rows[i]["states"] = fig["states"]
-    edges = [rows[0]["estimates"][0]] + [r["estimates"][1] for r in rows]
-    Kn = GriddedController.from_controllers({"m3": edges}, Kbins, inputs=["x1", "x3"],
-                                            outputs=["u"], interpolation="bins")
-    meta["bins"] = rows
-    meta["hold_force"] = {
-        "budget": {"max_iter": max_iter, "rounds": rounds, "search_n": search_n,
-                   "u_bound": u_bound, "seed": HOLD_SEED},
-        "command": "python benchmarks/scheduled_tuned.py --hold-force "
-                   + " ".join(sys.argv[1:]),
-        "made": "benchmarks/scheduled_tuned.py --hold-force: from each bin's controller "
-                "of the table (warm start) and its design seats, rounds of "
-                "refine_seat_controller (the occupant route's options) each adding as a "
-                "design seat the seat where worst_bump_seats over the bin's set found the "
-                f"force above {HOLD_U:g} N (or the stroke above {HOLD_X1:g} m), until "
-                "the search found neither"}
-    meta.pop("certificate", None)       # the table changed: certify it anew
-    out.mkdir(parents=True, exist_ok=True)
-    save_scheduled_controller(out / "mu_scheduled.json", Kn, metadata=meta)
+    budget = {"max_iter": max_iter, "rounds": rounds, "search_n": search_n,
+              "u_bound": u_bound, "seed": HOLD_SEED, "disk_radius": disk_radius}
+    made = ("benchmarks/scheduled_tuned.py --hold-force: from each {what}'s controller "
+            "of the table (warm start) and its design seats, rounds of "
+            "refine_seat_controller (the occupant route's options) each adding as a "
+            "design seat the seat where worst_bump_seats over the {what}'s set found the "
+            f"force above {HOLD_U:g} N (or the stroke above {HOLD_X1:g} m), until "
+            "the search found neither")
+    command = "python benchmarks/scheduled_tuned.py " + " ".join(sys.argv[1:])
+    if bins:
+        Ks, meta = load_controller(start)
+        meta = dict(meta)
+        rows = [dict(r) for r in meta["bins"]]
+        Kbins = [Ks.at(m3=(r["estimates"][0] + r["estimates"][1]) / 2) for r in rows]
+        for kind, where, Kd, fig in done:
+            if kind != "bin":
+                continue
+            i = next(j for j, r in enumerate(rows) if tuple(r["estimates"]) == tuple(where))
+            Kbins[i] = controller_from_dict(Kd)
+            rows[i]["hold_force"] = fig
+            rows[i]["searched"] = fig["searched"]
+            rows[i]["states"] = fig["states"]
+        edges = [rows[0]["estimates"][0]] + [r["estimates"][1] for r in rows]
+        Kn = GriddedController.from_controllers({"m3": edges}, Kbins, inputs=["x1", "x3"],
+                                                outputs=["u"], interpolation="bins")
+        meta["bins"] = rows
+        meta["hold_force"] = {"budget": budget, "command": command,
+                              "made": made.format(what="bin")}
+        meta.pop("certificate", None)       # the table changed: certify it anew
+        out.mkdir(parents=True, exist_ok=True)
+        save_scheduled_controller(out / "mu_scheduled.json", Kn, metadata=meta)
+    if refs:
+        Kr, meta = load_controller(ref_start)
+        meta = dict(meta)
+        nodes = [dict(r) for r in meta["nodes"]]
+        Knodes = [Kr.at(m3=r["m3"]) for r in nodes]
+        for kind, where, Kd, fig in done:
+            if kind != "ref":
+                continue
+            i = next(j for j, r in enumerate(nodes) if float(r["m3"]) == float(where))
+            Knodes[i] = controller_from_dict(Kd)
+            nodes[i]["hold_force"] = fig
+            nodes[i]["searched"] = fig["searched"]
+            nodes[i]["states"] = fig["states"]
+        Kn = GriddedController.from_controllers({"m3": [r["m3"] for r in nodes]}, Knodes,
+                                                inputs=["x1", "x3"], outputs=["u"])
+        meta["nodes"] = nodes
+        meta["hold_force"] = {"budget": budget, "command": command,
+                              "made": made.format(what="reference")}
+        out.mkdir(parents=True, exist_ok=True)
+        save_scheduled_controller(out / "mu_at_mass.json", Kn, metadata=meta)
     return done
 
 
@@ -557,16 +628,27 @@ def main(argv=None):
                     help="the table --hold-force starts from")
     ap.add_argument("--bins", default=None,
                     help="--hold-force's bins, e.g. 30-40,60-70 (default all)")
+    ap.add_argument("--refs", default=None,
+                    help="--hold-force's references (masses of mu_at_mass.json), e.g. "
+                         "30,50,70; with --bins none, the references alone")
+    ap.add_argument("--ref-start", default=str(DATA / "mu_at_mass.json"),
+                    help="the references --hold-force starts from")
+    ap.add_argument("--disk-radius", type=float, default=None,
+                    help="--hold-force's pole bound, rad/s (RefineOptions.disk_radius; "
+                         "a controller with a pole beyond it gets a round)")
     ap.add_argument("--hold-rounds", type=int, default=HOLD_ROUNDS)
     ap.add_argument("--hold-iter", type=int, default=MAX_ITER)
     args = ap.parse_args(argv)
     out = Path(args.out)
     if args.hold_force:
-        bins = ([tuple(float(v) for v in w.split("-")) for w in args.bins.split(",")]
+        bins = ([] if args.bins == "none" else
+                [tuple(float(v) for v in w.split("-")) for w in args.bins.split(",")]
                 if args.bins else list(zip(EDGES[:-1], EDGES[1:])))
+        refs = [float(m) for m in args.refs.split(",")] if args.refs else []
         hold_force(Path(args.start), out, bins=bins, max_iter=args.hold_iter,
                    rounds=args.hold_rounds, search_n=HOLD_SEARCH_N,
-                   u_bound=args.u_bound, jobs=args.jobs)
+                   u_bound=args.u_bound, jobs=args.jobs, disk_radius=args.disk_radius,
+                   refs=refs, ref_start=Path(args.ref_start))
         if not args.certify:
             return
     budget = ({"max_iter": 30, "rounds": 1, "n_search": 5} if args.quick else
