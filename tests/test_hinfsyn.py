@@ -903,6 +903,53 @@ def test_lmi_optimum_and_riccati_solutions_agree_within_gamma_relax():
     assert res.gamma_lower <= res.gamma <= res.gamma_lower * (1 + relax)
 
 
+@pytest.mark.parametrize("n", [8, 16])
+def test_the_riccati_start_certifies_as_the_identity_start(n):
+    """The default start of the γ minimisation, in the frame of the Riccati solutions at
+    a searched level (:func:`~lmi_suspension.synthesis.lmi.riccati_start`), against the
+    identity frame (``start="identity"``, the default until 2026-12-02) on the 8- and
+    16-state benchmark plants, each controller certified by ``hinfnorm(lft(P, K))``:
+    the certified γ agree within ``gamma_relax`` (5.003074 against 5.003187, 3.315674
+    against 3.315711), and the default's optimum is no higher (the identity frame's is
+    held up by its trace bound: 5.002895 against 5.003042, 3.315093 against 3.315236;
+    measured 2026-12-02)."""
+    P = _bench_plant(n)
+    relax = HinfsynOptions().gamma_relax
+    new = hinfsyn(P, 4, 4)
+    old = hinfsyn(P, 4, 4, options=HinfsynOptions(start="identity"))
+    for res in (new, old):
+        assert_certified(res, P)
+        assert res.gamma_lower is not None and not res.warnings
+        assert res.gamma <= res.gamma_lower * (1 + relax)
+    assert new.gamma == pytest.approx(old.gamma, rel=relax)
+    assert new.gamma_lower <= old.gamma_lower * (1 + 1e-6)
+
+
+def test_riccati_start_is_within_its_bracket_of_the_optimum():
+    """:func:`~lmi_suspension.synthesis.lmi.riccati_start` on the scaled 8-state
+    benchmark plant: its level has a frame and lies between the optimum of the γ
+    minimisation in the identity frame (an independent computation; the Riccati and LMI
+    optima of a regular plant agree to ``gamma_relax``, see the test above) and
+    ``4**(1/4)`` times it; on a singular plant (COMPleib AC3: no Riccati equations)
+    there is no start."""
+    from lmi_suspension.examples import compleib
+    from lmi_suspension.lti.scaling import scale_plant
+    from lmi_suspension.synthesis.lmi import Frame, gamma_lmi, riccati_start
+
+    Ps, _ = scale_plant(GeneralizedPlant.from_statespace(_bench_plant(8), 4, 4))
+    level, frame = riccati_start(Ps)
+    assert isinstance(frame, Frame) and frame.sigma.size == 8
+    optimum = gamma_lmi(Ps, HinfsynOptions(start="identity")).gamma
+    assert optimum * (1 - HinfsynOptions().gamma_relax) <= level <= optimum * 4 ** 0.25
+    AC3, _ = scale_plant(compleib("AC3"))
+    assert riccati_start(AC3) is None
+
+
+def test_start_option_is_checked():
+    with pytest.raises(ParameterError, match="start"):
+        HinfsynOptions(start="frame")
+
+
 @pytest.mark.parametrize("seed", [14, 34])
 def test_the_reported_optimum_is_not_beaten_by_more_than_gamma_relax(seed):
     """Two routes on regular 12-state random plants: the LMI route's optimum
