@@ -752,9 +752,10 @@ def riccati_start(P: GeneralizedPlant, floor: float = 0.0) -> "tuple[float, Fram
     The γ minimisation in the identity frame ends where its trace bound holds the
     Lyapunov variables, which on plants whose optimal ``R`` and ``S`` grow without
     bound costs iterations and optimum: on the 60-state plant of ``bench_hinfsyn.py``
-    22 iterations and 29.84497, in the frame of this level 17 and 29.83952 (the
-    bound inactive); at 22 states 21 and 8.17204 against 17 and 8.17175, at 40 states
-    23 and 68.8980 against 18 and 68.8848 (measured 2026-12-02).  Only the frame is
+    22 iterations and 29.84497, in the frame of this level (with ``hinfsyn``'s bound
+    there, ``_START_XY_BOUND``) 17 and 29.83953; at 22 states 21 and 8.17204 against
+    15 and 8.17175, at 40 states 23 and 68.8980 against 16 and 68.8848 (measured
+    2026-12-02).  Only the frame is
     taken from the Riccati solutions: the LMI decides the level.  A bracket search by
     factors of 4 from 1, then :data:`_START_BISECTIONS` halvings; every step solves the
     two Riccati equations.
