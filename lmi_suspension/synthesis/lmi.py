@@ -760,6 +760,18 @@ def riccati_start(P: GeneralizedPlant, floor: float = 0.0) -> "tuple[float, Fram
     factors of 4 from 1, then :data:`_START_BISECTIONS` halvings; every step solves the
     two Riccati equations.
 
+    Parameters
+    ----------
+    P : GeneralizedPlant
+        Scaled plant with ``D22 = 0``.
+    floor : float
+        Least level (scaled units) worth a frame.
+
+    Returns
+    -------
+    tuple of (float, Frame) or None
+        The level and the frame of the Riccati solutions there.
+
     Examples
     --------
     >>> from lmi_suspension.examples import skogestad_distillation
