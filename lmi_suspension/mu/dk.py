@@ -39,6 +39,7 @@ from ..errors import DimensionError, InfeasibleError, LmiSuspensionError, Parame
 from ..lti.checks import as_finite_array, sample_time
 from ..lti.norms import freqresp, hinfnorm
 from ..lti.plant import GeneralizedPlant, lft
+from ..lti.reduce import balanced_truncation
 from ..lti.scaling import balanced_statespace
 from ..umodel.blocks import BlockStructure
 from .dsearch import search_dscales
@@ -399,6 +400,11 @@ class MusynIteration:
     certificates : tuple of SpecificationCertificate
         With ``constraints``: each constraint recomputed on ``F_l(P, K)`` (the plant as
         given, not the scaled one) for this iteration's controller.
+    PD : control.StateSpace or None
+        The scaled plant the controller was synthesized on (``gamma`` is its norm there;
+        the plant as given at the first iteration).  In D-K its fitted D scalings are
+        feasible at every frequency, so ``‖F_l(PD, K')‖∞`` bounds µ of any controller
+        ``K'``'s loop: the order reduction's certificate (``MusynOptions.reduce_order``).
     """
 
     index: int
@@ -416,6 +422,7 @@ class MusynIteration:
     K: control.StateSpace | None = field(default=None, repr=False, compare=False)
     stage: str = "dk"
     certificates: tuple = ()
+    PD: control.StateSpace | None = field(default=None, repr=False, compare=False)
 
 
 @dataclass(frozen=True)
@@ -867,7 +874,7 @@ def _dk_loop(setup, steps: DKSteps, given, callback, hinfsyn, t_start: float):
             seconds_d=t2 - t1, seconds_fit=t4 - t3,
             warnings=tuple(syn.warnings) + (() if mixed and it > 1 else _bound_check(
                 float(syn.gamma), here.lower_peak, f"iteration {it}")),
-            gamma_prev=gamma_prev, K=K, certificates=certs)
+            gamma_prev=gamma_prev, K=K, certificates=certs, PD=nxt.PD)
         history.append(record)
         logger.info("musyn iteration %d: gamma=%.4f (previous K %.4f) mu=%.4f (lower %.4f) "
                     "K order %d D orders %s [K %.2fs, D %.2fs, fit %.2fs]", it, record.gamma,
@@ -933,6 +940,7 @@ def _certified(setup, best, history, stop_reason: str, t_start: float,
          rival) = _against_complex(setup, rival, history, best, stop_reason)
     checks: tuple = ()
     mu_bound = float("inf")
+    scaled = None  # the best iterate's scaled plant, where its γ bounds µ
     # (a D-G-K iterate's γ is the norm of a G-scaled plant, not a bound of µ)
     if not (mixed and best_it != 1):
         # the dense grid reaches below the design grid, where a certificate computed on
@@ -945,12 +953,17 @@ def _certified(setup, best, history, stop_reason: str, t_start: float,
                               rtol=_DENSE_BOUNDS_RTOL)
         if not checks and not constraints and not mixed and np.max(final.upper) <= gamma:
             mu_bound = gamma  # the scaled loop's norm: a bound at every frequency
+            scaled = history[best_it - 1].PD
     reduced_from, K_full, mu_full = None, None, None
-    reduced = _reduction(setup, K, final, dense, rng)
+    reduced = _reduction(setup, K, final, dense, rng, scaled)
     if reduced is not None:
         reduced_from, K_full, mu_full = K.nstates, K, float(np.max(final.upper))
-        K, CL, CL_full, final = reduced
-        mu_bound = float("inf")  # γ bounded the full order's loop, not this one
+        K, CL, CL_full, final, gamma_red = reduced
+        # γ bounded the full order's loop; the reduced one's own norm on the same scaled
+        # plant bounds its µ where the search computed it (and the dense grid agrees)
+        mu_bound = (gamma_red if np.isfinite(gamma_red) and np.max(final.upper) <= gamma_red
+                    and np.max(final.lower) <= gamma_red * (1.0 + _DENSE_BOUNDS_RTOL)
+                    else float("inf"))
     upper = np.asarray(final.upper)
     k_peak = int(np.argmax(upper))
     if not mu_bound <= upper[k_peak] * (1.0 + _SUP_RTOL):
@@ -1289,21 +1302,29 @@ def _search_stage(G, nmeas, ncon, struct, omega, dstep, opts, rng, *, index, hin
                   f"{found.level_start:.6g} -> {found.level:.6g}, controller certified "
                   f"{found.gamma:.6g}",)
         + _bound_check(found.gamma, lower_peak, "D-scale search"),
-        gamma_prev=found.level_start, K=found.K, stage="dscale_search")
+        gamma_prev=found.level_start, K=found.K, stage="dscale_search", PD=found.PD)
 
 
-def _reduction(setup, K, final, dense, rng):
+def _reduction(setup, K, final, dense, rng, scaled=None):
     """The returned controller's order reduction (``reduce_order``): ``(K, CL, CL_full,
-    final)`` of the balanced truncation kept, or None.  A truncation is kept where its
-    loop is stable, meets the constraints, and its µ peak on the dense grid is within
-    ``reduce_mu_tol`` of the full order's.  With ``"auto"`` the least such order is
-    found by bisection between 1 and the full order (µ of a balanced truncation falls
-    nearly monotonically with its order).
+    final, gamma)`` of the balanced truncation kept, or None.  A truncation is kept where
+    its loop is stable, meets the constraints, and its µ is within ``reduce_mu_tol`` of
+    the full order's dense-grid peak.  With ``"auto"`` the least such order is found by
+    bisection between 1 and the full order (µ of a balanced truncation falls nearly
+    monotonically with its order).
 
-    An order is judged by :func:`_within`: the full loop's scalings at each dense
+    Where the best iterate's scaled plant ``scaled`` is known (D-K, no constraints, its
+    γ consistent with the dense grid), an order is judged first by the truncated
+    controller's norm on it (:func:`_scaled_norm`): its fitted D scalings are feasible
+    at every frequency, so that norm ``gamma`` bounds the truncated loop's µ at every
+    frequency, one ``hinfnorm`` per order.  It is conservative (the scalings are the full
+    loop's), so where no order below the full one passes it, the orders are judged by
+    their µ on the dense grid (:func:`_within`: the full loop's scalings at each dense
     frequency bound the truncated loop's µ there in one eigenvalue problem, and µ itself
-    is computed only where that bound is above the limit; the chosen order's µ on the
-    whole dense grid is computed once, at the end."""
+    is computed only where that bound is above the limit; ``gamma`` is then inf).  The
+    chosen order's µ on the whole dense grid is computed once, at the end.  On default
+    ``musyn``'s distillation loop both judge the same order (15 of 22 states); the norms
+    took 0.05 s where the dense-grid judgement took 1.4 s (measured 2026-12-02)."""
     opts = setup.options
     if opts.reduce_order is None:
         return None
@@ -1321,14 +1342,15 @@ def _reduction(setup, K, final, dense, rng):
             return None
         return K_red, CL_red, CL_red_full
 
-    def accepted(order: int) -> bool:
+    def by_norm(order: int) -> float:
+        loop = truncated(order)
+        return np.inf if loop is None else _scaled_norm(scaled, loop[0], setup)
+
+    def by_mu(order: int) -> bool:
         loop = truncated(order)
         return loop is not None and _within(loop[1], setup.struct, final, dense, limit, rng)
 
-    if opts.reduce_order != "auto":
-        order = int(opts.reduce_order)
-        candidates = [order] if order < K.nstates and accepted(order) else []
-    else:
+    def least(accepted) -> int:
         lo, hi = 1, K.nstates  # the full order is acceptable; the least acceptable is sought
         while lo < hi:
             mid = (lo + hi) // 2
@@ -1336,16 +1358,43 @@ def _reduction(setup, K, final, dense, rng):
                 hi = mid
             else:
                 lo = mid + 1
+        return hi
+
+    gammas: dict[int, float] = {}
+
+    def norm_passes(order: int) -> bool:
+        gammas[order] = by_norm(order)
+        return gammas[order] <= limit
+
+    if opts.reduce_order != "auto":
+        order = int(opts.reduce_order)
+        candidates = [order] if order < K.nstates and (
+            (scaled is not None and norm_passes(order)) or by_mu(order)) else []
+    else:
+        hi = least(norm_passes) if scaled is not None else K.nstates
+        if hi == K.nstates:
+            hi = least(by_mu)
         candidates = list(range(hi, K.nstates))
     for order in candidates:  # the first, unless the dense µ disagrees with the judgement
-        K_red, CL_red, CL_red_full = truncated(order)
+        loop = truncated(order)
+        if loop is None:
+            continue
+        K_red, CL_red, CL_red_full = loop
         final_red = _final_bounds(CL_red, setup.struct, dense, rng)
         peak = float(np.max(final_red.upper))
-        logger.info("musyn: order %d: µ %.4f (full order %d: %.4f)", order, peak,
-                    K.nstates, float(np.max(final.upper)))
-        if peak <= limit:
-            return K_red, CL_red, CL_red_full, final_red
+        gamma = gammas.get(order, np.inf)
+        logger.info("musyn: order %d: µ %.4f, scaled norm %.4f (full order %d: %.4f)", order,
+                    peak, gamma, K.nstates, float(np.max(final.upper)))
+        if peak <= limit or gamma <= limit:
+            return K_red, CL_red, CL_red_full, final_red, gamma
     return None
+
+
+def _scaled_norm(PD, K_red, setup) -> float:
+    """``‖F_l(PD, K_red)‖∞`` on the µ channels: with ``PD`` a D-K scaled plant, an upper
+    bound of µ of ``K_red``'s loop at every frequency."""
+    return float(hinfnorm(mu_part(lft(PD, K_red, setup.nmeas, setup.ncon),
+                                  setup.struct))[0])
 
 
 def _within(CL_red, struct, final, dense, limit: float, rng) -> bool:
@@ -1365,8 +1414,9 @@ def _within(CL_red, struct, final, dense, limit: float, rng) -> bool:
     beta = np.array([_certify(M[:, :, k], XL[:, :, k], XR[:, :, k], final.G[:, :, k])
                      for k in range(dense.size)])
     over = np.flatnonzero(beta > limit)
+    over = over[np.argsort(-beta[over], kind="stable")]  # highest first
     for start in range(0, over.size, _REFINE_BATCH):
-        batch = over[np.argsort(-beta[over], kind="stable")][start:start + _REFINE_BATCH]
+        batch = over[start:start + _REFINE_BATCH]
         mu = _final_bounds(CL_red, struct, dense[batch], rng)
         if float(np.max(mu.upper)) > limit:
             return False
@@ -1374,9 +1424,12 @@ def _within(CL_red, struct, final, dense, limit: float, rng) -> bool:
 
 
 def _try_reduce(K: control.StateSpace, order: int):
-    """Balanced truncation of the stable part (python-control ``balred``); None on failure."""
+    """Balanced truncation of ``K`` to ``order`` states, its modes near and right of the
+    axis kept whole (:func:`~lmi_suspension.lti.reduce.balanced_truncation`); None where
+    that fails or cannot reach ``order``."""
     try:
-        return control.balred(K, order, method="truncate")
-    except Exception as exc:  # slycot raises plain ValueError/ArithmeticError variants
+        K_red = balanced_truncation(K, order=order)[0]
+    except Exception as exc:  # slycot and scipy raise plain ValueError/ArithmeticError kinds
         logger.info("musyn: order reduction to %d failed: %s", order, exc)
         return None
+    return K_red if K_red.nstates <= order else None
