@@ -171,8 +171,8 @@ class MusynOptions:
         and in D-G-K or with constraints, by µ on the dense grid.  On dkpy's
         distillation example 15 states instead of 22 at µ 0.960037 (scaled norm
         0.960861) instead of 0.958751; the order search, the reduced loop's dense-grid µ
-        and its all-frequency bound took 0.6 s of CPU where the dense-grid judgement and
-        an interval bound took 2.7 s (a bound of 1.0239; measured 2026-12-02).  Twelve
+        and its all-frequency bound took 0.46 s of CPU where the dense-grid judgement and
+        an interval bound took 2.6 s (a bound of 1.0239; measured 2026-12-02).  Twelve
         states cost more than 1 %: balanced truncation +2.76 % (µ on the dense grid),
         frequency-weighted truncations +2.3 % and more, a truncation polished on the
         scaled plant with its D scalings held +1.60 % (83 s of CPU); the trade-off is in
