@@ -170,8 +170,9 @@ class MusynOptions:
         is conservative (the scalings are the full loop's), so the order below the
         least one it passes is judged by µ on the dense grid too, and the search goes on
         by µ where that passes; where no order passes the norm, and in D-G-K or with
-        constraints, orders are judged by µ alone (``mu_bound`` then the interval
-        bound's).  On dkpy's
+        constraints, orders are judged by µ alone (an order kept by µ has its scaled
+        norm as ``mu_bound`` where it was computed, else the interval bound's).  On
+        dkpy's
         distillation example 15 states instead of 22 at µ 0.960037 (scaled norm
         0.960861) instead of 0.958751; the order search, the reduced loop's dense-grid µ
         and its all-frequency bound took 0.61 s of CPU where the dense-grid judgement and
@@ -466,8 +467,9 @@ class MusynResult:
         returned controller on its D-scaled plant (the iterate's ``gamma``), where that
         is consistent with the dense grid (no lower bound above it, no grid peak above
         it).  ``mu_bound / mu_peak - 1`` says how far off the grid µ may rise.  For a
-        reduced controller judged by its norm on the best iterate's scaled plant
-        (``MusynOptions.reduce_order``), that norm, and no interval bound.
+        reduced controller whose norm on the best iterate's scaled plant the order
+        search computed (``MusynOptions.reduce_order``), that norm, and no interval
+        bound.
     mu_lower_peak : float
         Peak of the µ lower bound over the dense grid (a lower bound of ``sup_ω µ``).
     mu : MussvResult
