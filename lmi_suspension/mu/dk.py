@@ -172,8 +172,7 @@ class MusynOptions:
         by µ where that passes; where no order passes the norm, and in D-G-K or with
         constraints, orders are judged by µ alone (an order kept by µ has its scaled
         norm as ``mu_bound`` where it was computed, else the interval bound's).  On
-        dkpy's
-        distillation example 15 states instead of 22 at µ 0.960037 (scaled norm
+        dkpy's distillation example 15 states instead of 22 at µ 0.960037 (scaled norm
         0.960861) instead of 0.958751; the order search, the reduced loop's dense-grid µ
         and its all-frequency bound took 0.61 s of CPU where the dense-grid judgement and
         an interval bound took 2.6 s (a bound of 1.0239; measured 2026-12-02).  Twelve
@@ -1003,10 +1002,10 @@ def _certified(setup, best, history, stop_reason: str, t_start: float,
                     else float("inf"))
     upper = np.asarray(final.upper)
     k_peak = int(np.argmax(upper))
-    # a reduced loop's scaled norm is kept as it is: it is within reduce_mu_tol of the
-    # full order's µ by its choice, and 20 splits of the interval bound did not come
-    # near it on distillation (1.0760 against 1.0475 after two D-K iterations, 1.0239
-    # against 0.9609 after the default run; measured 2026-12-02)
+    # a reduced loop's scaled norm is kept as it is (a bound at every frequency; within
+    # reduce_mu_tol of the full order's µ where it chose the order): 20 splits of the
+    # interval bound did not come near it on distillation (1.0760 against 1.0475 after
+    # two D-K iterations, 1.0239 against 0.9609 after the default run; 2026-12-02)
     if not mu_bound <= upper[k_peak] * (1.0 + _SUP_RTOL) and (
             reduced is None or not np.isfinite(mu_bound)):
         mu_bound = min(mu_bound, interval_bound(CL, final, dense, rtol=_SUP_RTOL,
