@@ -7,7 +7,8 @@ dkpy's run is its ``examples/1_example_dk_iter_fixed_order.py`` (dkpy 0.1.9):
 (``SsvLmiBisection(n_jobs=1)``, Clarabel), the SLICOT D-fit (``DScaleFitSlicot``), 3
 iterations, fit order 4, on ``np.logspace(-3, 3, 61)``.  ``musyn`` runs with its
 defaults (the controller reduced to the least order within 1 % of the full order's µ;
-both are certified) on the same plant (dkpy's ``example_skogestad2006_p325()["P"]``, the
+both are certified; its own µ is printed with its bound at every frequency,
+``MusynResult.mu_bound``) on the same plant (dkpy's ``example_skogestad2006_p325()["P"]``, the
 project's :func:`~lmi_suspension.examples.skogestad_distillation` where dkpy is not
 installed) and the same grid.  The rounds alternate which one runs first.
 
@@ -86,7 +87,8 @@ def run_dkpy(dkpy, P, nmeas, ncon):
 def run_musyn(P, nmeas, ncon):
     t0, c0 = time.perf_counter(), _cpu()
     res = musyn(P, nmeas, ncon, BLK, omega=OMEGA)
-    return res.K, time.perf_counter() - t0, _cpu() - c0, res.mu_peak, res.K_full
+    return (res.K, time.perf_counter() - t0, _cpu() - c0, res.mu_peak, res.K_full,
+            res.mu_bound)
 
 
 if __name__ == "__main__":
@@ -115,12 +117,14 @@ if __name__ == "__main__":
         for name in order:
             if name == "dkpy" and dkpy is None:
                 continue
-            K, seconds, cpu_s, own, K_full = (run_dkpy(dkpy, P, nmeas, ncon) + (None,)
-                                              if name == "dkpy" else run_musyn(P, nmeas, ncon))
+            K, seconds, cpu_s, own, K_full, bound = (
+                run_dkpy(dkpy, P, nmeas, ncon) + (None, None) if name == "dkpy"
+                else run_musyn(P, nmeas, ncon))
             times[name].append(seconds)
             cpu[name].append(cpu_s)
             print(f"round {r + 1} {name:5s}: {seconds:6.1f} s (CPU {cpu_s:6.1f} s), own µ "
-                  f"{own:.4f}, certified µ "
+                  f"{own:.4f}" + ("" if bound is None else f" (bound at every frequency "
+                                     f"{bound:.4f})") + ", certified µ "
                   f"{certified_mu(P, K, nmeas, ncon):.4f}, controller order {K.nstates}"
                   + ("" if K_full is None else  # musyn's default order reduction
                      f" (full order {K_full.nstates}: certified µ "

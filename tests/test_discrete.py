@@ -271,6 +271,9 @@ def _assert_discrete_certified(res, blk, dt):
 
     assert res.K.dt == dt and res.CL.dt == dt
     assert all(r.K is None or r.K.dt == dt for r in res.history)
+    # the full-order controller of a reduction and the iterates' scaled plants too
+    assert res.K_full is None or res.K_full.dt == dt
+    assert all(r.PD is None or r.PD.dt == dt for r in res.history)
     assert np.all(np.abs(res.CL.poles()) < 1)
     assert 0 < res.peak_omega <= np.pi / dt and np.all(res.omega < np.pi / dt)
     assert res.mu_lower_peak <= res.mu_peak * (1 + 1e-9)

@@ -57,7 +57,8 @@ def musyn_discrete(musyn, G: GeneralizedPlant, nmeas: int, ncon: int, blk, *, om
 
     def to_discrete(rec):
         K = None if rec.K is None else tustin(rec.K, dt)
-        return dataclasses.replace(rec, K=K, peak_omega=float(_back(rec.peak_omega, dt)))
+        PD = None if rec.PD is None else tustin(rec.PD, dt)  # F_l commutes with the map
+        return dataclasses.replace(rec, K=K, PD=PD, peak_omega=float(_back(rec.peak_omega, dt)))
 
     res = musyn(Gc, nmeas, ncon, blk, omega=omega_c, options=options,
                 callback=None if callback is None else (lambda rec: callback(to_discrete(rec))),
@@ -81,6 +82,7 @@ def musyn_discrete(musyn, G: GeneralizedPlant, nmeas: int, ncon: int, blk, *, om
                              else float(_back(res.mu.peak_omega, dt)))
     return dataclasses.replace(
         res, K=K, CL=CL, peak_omega=peak_omega, mu=mu, omega=_back(res.omega, dt),
+        K_full=None if res.K_full is None else tustin(res.K_full, dt),
         history=tuple(to_discrete(r) for r in res.history), warnings=tuple(warnings),
         complex_run=None if res.complex_run is None else dataclasses.replace(
             res.complex_run, K=tustin(res.complex_run.K, dt),

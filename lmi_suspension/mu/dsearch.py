@@ -35,7 +35,7 @@ from __future__ import annotations
 import logging
 import time
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import control
 import numpy as np
@@ -134,6 +134,8 @@ class DScaleSearchResult:
         level by ``achieves``, which costs one synthesis.
     seconds : float
         Wall time.
+    PD : control.StateSpace or None
+        The scaled plant of the best scalings, on which ``gamma`` is certified.
     """
 
     K: control.StateSpace
@@ -143,6 +145,7 @@ class DScaleSearchResult:
     dfit: DScaleFit
     evaluations: int
     seconds: float
+    PD: control.StateSpace | None = field(default=None, repr=False, compare=False)
 
 
 def _equal_scalings(d_blocks: np.ndarray, free: list[int], rtol: float = _TIE_RTOL
@@ -409,4 +412,4 @@ def search_dscales(P, nmeas: int, ncon: int, block_sizes, omega, d_blocks, weigh
         return None
     return DScaleSearchResult(K=K, gamma=gamma, level=best["level"], level_start=level_start,
                               dfit=best["dfit"], evaluations=evals[0],
-                              seconds=time.perf_counter() - t0)
+                              seconds=time.perf_counter() - t0, PD=best["PD"])

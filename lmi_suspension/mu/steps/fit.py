@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import functools
 import logging
-import warnings
 from dataclasses import replace
 
 import control
@@ -20,6 +19,7 @@ import numpy as np
 
 from ...lti.norms import freqresp, hinfnorm
 from ...lti.plant import lft
+from ...lti.reduce import balanced_truncation
 from ...umodel.blocks import BlockStructure
 from . import DKSetup, LoopAnalysis, NextPlant, ScaleFit, block_sizes, mu_part
 
@@ -182,60 +182,14 @@ _KSTEP_REDUCE_TOL = 1e-2
 #: largest relative change of the previous controller's norm on the reduced scaled plant
 #: (against the full one) for which the reduced plant is used (see DGScaleFit)
 _KSTEP_REDUCE_LOOP_RTOL = 2e-2
-#: a mode of the scaled plant with real part above -_AXIS_REL * max(1, |λ|) stays out of
-#: the truncation (the rigid-body double pole of the two-mass plant sits at ±2e-8)
-_AXIS_REL = 1e-6
-
-
-def _split(sys: control.StateSpace):
-    """``(stable, rest)`` with ``sys = stable + rest``: ordered real Schur form and a
-    Sylvester equation; ``rest`` holds the modes near and right of the axis, and D."""
-    from scipy.linalg import schur, solve_sylvester
-
-    A, B, C, D = (np.asarray(m, dtype=float) for m in (sys.A, sys.B, sys.C, sys.D))
-    T, Q, k = schur(A, output="real",
-                    sort=lambda x, y: x < -_AXIS_REL * max(1.0, float(np.hypot(x, y))))
-    T11, T12, T22 = T[:k, :k], T[:k, k:], T[k:, k:]
-    X = solve_sylvester(T11, -T22, -T12)
-    QB, CQ = Q.T @ B, C @ Q
-    stable = control.ss(T11, QB[:k] - X @ QB[k:], CQ[:, :k], np.zeros_like(D))
-    rest = control.ss(T22, QB[k:], CQ[:, :k] @ X + CQ[:, k:], D)
-    return stable, rest
-
-
 def reduced_for_kstep(PD: control.StateSpace, tol: float = _KSTEP_REDUCE_TOL):
     """``(PDr, bound)``: ``PD`` with its stable part balanced-truncated (SLICOT AB09AD,
-    square-root method) to the least order whose error bound ``2 Σ σ_dropped`` is at
-    most ``tol``, and that bound (0 where nothing is dropped).  ``PD`` itself, bound 0,
-    where the reduction fails (logged at INFO)."""
-    from slycot import ab09ad
-
+    square-root method; :func:`~lmi_suspension.lti.reduce.balanced_truncation`) to the
+    least order whose error bound ``2 Σ σ_dropped`` is at most ``tol``, and that bound
+    (0 where nothing is dropped).  ``PD`` itself, bound 0, where the reduction fails
+    (logged at INFO)."""
     try:
-        stable, rest = _split(PD)
-        n, m, p = stable.nstates, stable.ninputs, stable.noutputs
-        if n < 2:
-            return PD, 0.0
-        A, B, C = (np.asarray(x, dtype=float) for x in (stable.A, stable.B, stable.C))
-        with warnings.catch_warnings():
-            # slycot warns where the stable part is not minimal (the order is then
-            # its minimal one, and the dropped singular values are zeros)
-            warnings.simplefilter("ignore")
-            *_, hsv = ab09ad("C", "B", "S", n, m, p, A.copy(), B.copy(), C.copy(), nr=n)
-        hsv = np.sort(np.asarray(hsv, dtype=float))[::-1]
-        if not np.all(np.isfinite(hsv)):
-            raise ValueError(f"Hankel singular values {hsv}")
-        tail = np.append(2.0 * np.cumsum(hsv[::-1])[::-1], 0.0)  # tail[r]: drop r..n-1
-        r = int(next(k for k in range(n + 1) if tail[k] <= tol))
-        if r >= n:
-            return PD, 0.0
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            nr, Ar, Br, Cr, _ = ab09ad("C", "B", "S", n, m, p, A.copy(), B.copy(), C.copy(),
-                                       nr=r)
-        reduced = control.ss(Ar[:nr, :nr], Br[:nr], Cr[:, :nr], np.zeros((p, m)))
-        PDr = control.parallel(reduced, rest) if rest.nstates else control.ss(
-            reduced.A, reduced.B, reduced.C, np.asarray(rest.D))
-        return PDr, float(tail[nr])
+        return balanced_truncation(PD, tol=tol)
     except Exception as exc:  # slycot and scipy raise plain ValueError/ArithmeticError kinds
         logger.info("musyn: no reduction of the %d-state scaled plant (%s); the K-step sees "
                     "it whole", PD.nstates, exc)
