@@ -520,8 +520,9 @@ def _mixed_mu(P, K, omega):
 def test_auto_goes_on_from_the_complexified_controller_where_its_first_k_step_improves(
         monkeypatch):
     """``complex_candidate="auto"`` (the default): D-G-K starts from the complexified
-    controller; its second iterate is reported at half its µ (an improvement), so that
-    start is kept: one mixed phase only, its first iterate the complexified controller,
+    controller; its first iterate is reported 10 % below its mixed µ (so below the
+    controller's complex µ: the start is tried) and its second at 45 % (an
+    improvement), so that start is kept: one mixed phase only, its first iterate the complexified controller,
     every record reported to the callback once decided.  Its third iterate, reported as
     it is (more than ``_DGK_REGRESSION`` above the halved best), ends D-G-K before
     ``max_iter``.  The result is certified apart: its mixed µ (LMI bound, recomputed here)
@@ -533,7 +534,7 @@ def test_auto_goes_on_from_the_complexified_controller_where_its_first_k_step_im
     P = oscillator()
     made, seen = [], []
     res = musyn(P, 1, 1, BLK, omega=_QUICK_W, callback=seen.append,
-                steps=DKSteps(dgstep=_steered_dg_step([(1.0, 0.5)], made)),
+                steps=DKSteps(dgstep=_steered_dg_step([(0.9, 0.45)], made)),
                 options=MusynOptions(max_iter=4, max_dfit_order=1, **_QUICK))
     assert len(made) == 1  # no D-G-K from the beginning
     assert made[0][0] is res.complex_run.K and res.history[0].K is res.complex_run.K
@@ -545,25 +546,28 @@ def test_auto_goes_on_from_the_complexified_controller_where_its_first_k_step_im
     assert res.mu_peak <= _mixed_mu(P, res.complex_run.K, dense) * (1 + 2e-3)
 
 
-def test_auto_abandons_the_complexified_start_where_its_first_k_step_does_not_improve(
-        monkeypatch):
-    """``complex_candidate="auto"``: the start from the complexified controller reports
-    its second iterate at twice its µ, so it is abandoned after that iterate (its two
-    records kept in ``complex_run.start_history``, not reported) and D-G-K starts from
-    the beginning (a second mixed phase, whose first controller is its own K-step's).
-    The result is certified apart and no worse than the complexified controller."""
+@pytest.mark.parametrize("factors", [(0.9, 2.0), (1.5,)])
+def test_auto_abandons_the_complexified_start_where_it_does_not_improve(monkeypatch, factors):
+    """``complex_candidate="auto"``: the start from the complexified controller is
+    abandoned where its second iterate (its first K-step) is reported at twice its µ,
+    after that iterate; or where its first iterate is reported at 1.5 times its mixed µ
+    (then above the controller's complex µ: G = 0 is optimal at its peak), at once.  Its
+    records are kept in ``complex_run.start_history``, not reported, and D-G-K starts
+    from the beginning (a second mixed phase, whose first controller is its own
+    K-step's).  The result is certified apart and no worse than the complexified
+    controller."""
     from lmi_suspension.mu.steps import DKSteps
 
     _coarse_dense_grid(monkeypatch)
     P = oscillator()
     made, seen = [], []
     res = musyn(P, 1, 1, BLK, omega=_QUICK_W, callback=seen.append,
-                steps=DKSteps(dgstep=_steered_dg_step([(1.0, 2.0)], made)),
+                steps=DKSteps(dgstep=_steered_dg_step([factors], made)),
                 options=MusynOptions(max_iter=2, max_dfit_order=1, **_QUICK))
-    assert len(made) == 2 and len(made[0]) == 2
+    assert len(made) == 2 and len(made[0]) == len(factors)
     trial = res.complex_run.start_history
-    assert len(trial) == 2 and trial[0].K is res.complex_run.K
-    assert "abandoned at iteration 2" in res.stop_reason
+    assert len(trial) == len(factors) and trial[0].K is res.complex_run.K
+    assert f"abandoned at iteration {len(factors)}" in res.stop_reason
     assert seen == list(res.history) and res.history[0].K is not res.complex_run.K
     assert all(rec.K is not K for rec in res.history for K in made[0])
     assert np.all(res.CL.poles().real < 0) and res.mu_lower_peak <= res.mu_peak

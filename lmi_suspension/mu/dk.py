@@ -273,7 +273,8 @@ class MusynOptions:
         failed (1.7778, the complexified controller, in 93 s against 162 s); on the
         oscillator of ``tests/test_dgk.py`` 1.0659 against 1.0391, both in about 60 s
         (complexified D-K: 1.7778 in 68 s and 1.1140 in 44 s).  ``stop_reason`` says which
-        controller is returned (``best_iteration`` 0: the complexified run's) and
+        controller is returned (``best_iteration`` 0: the complexified run's; 1 where
+        D-G-K started from it) and
         :attr:`MusynResult.complex_run` holds that run (its records do not go to
         ``callback``).  ``None``: D-G-K alone, which
         can end above complex D-K (the seat over m3 and k1: 2.734 against 2.671,
@@ -288,9 +289,12 @@ class MusynOptions:
         complexified controller, and goes on from there where one of its first
         ``_TRIAL_ITERATIONS`` iterates improves on that controller's mixed µ by
         ``min_improvement`` on the design grid; where none does, that start is
-        abandoned (its records in :attr:`_ComplexRun.start_history`) and D-G-K starts
-        as with ``"keep"``.  With ``K0``, the complexified run and the start of
-        ``"keep"`` are from it.
+        abandoned (its records in ``complex_run.start_history``, not reported to
+        ``callback``; the records of a start kept are reported once it is decided) and
+        D-G-K starts as with ``"keep"``: the seat 2.6063 (31 states) in 2.1 times the
+        complexified run's CPU, the two-mass plant 1.6089 (abandoned at 1.8110) in 3.05
+        times (2026-12-02, ``benchmarks/HISTORY.md``).  With ``K0``, the complexified
+        run and the start of ``"keep"`` are from it.
     max_gfit_poles : int or None
         D-G-K: the largest basis of the G-scalings (poles per real block; each adds
         three states to the scaled plant per real channel, so this bounds the order of
@@ -577,7 +581,13 @@ def _complexified(struct: BlockStructure) -> BlockStructure:
 #: abandoned for D-G-K from the beginning.  Its second iterate is its first K-step: on
 #: the seat over m3 and k1 it went from 2.6704 to 2.5827, where the run ended (2.6063 on
 #: the dense grid); on the two-mass plant from 1.7779 to 1.8110, and D-G-K from the
-#: beginning reached 1.6085 (design grid, 2026-12-02, ``benchmarks/musyn_mixed.py``)
+#: beginning reached 1.6085 (design grid, 2026-12-02, ``benchmarks/musyn_mixed.py``).
+#: Before that K-step the start is abandoned where the first iterate's mixed µ is not
+#: below the controller's complex µ by ``min_improvement``: where they are equal at the
+#: peak, G = 0 is already an optimal scaling there and the first D-G-K plant is the one
+#: complex D-K stalled on.  The two-mass controller: complex 1.7787, mixed 1.7779 (0.04 %
+#: below; its K-step then went up to 1.8110); the seat's: 2.6975 and 2.6704 (1.0 % below;
+#: down to 2.5827)
 _TRIAL_ITERATIONS = 2
 #: D-G-K stops after an iterate whose µ peak is this much above the best iterate's
 #: (:func:`_regressed`).  Measured 2026-12-02 (``benchmarks/musyn_mixed.py``): the
@@ -796,7 +806,8 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
             rival.K, float(hinfnorm(mu_part(lft(setup.G, rival.K), setup.struct))[0]),
             ("the complexified D-K's controller: no K-step",))
         best, history, stop_reason, abandoned = _dk_loop(
-            setup, steps, from_complex, callback, hinfsyn, t_start, trial=mode == "auto")
+            setup, steps, from_complex, callback, hinfsyn, t_start,
+            trial=_complex_peak(rival) if mode == "auto" else None)
         if abandoned:
             # the start from the complexified controller did not improve on it: D-G-K
             # from the beginning (its own first K-step, or K0); the complexified
@@ -813,15 +824,18 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
 
 
 def _dk_loop(setup, steps: DKSteps, given, callback, hinfsyn, t_start: float, *,
-             trial: bool = False):
+             trial: float | None = None):
     """The D-K (or D-G-K) iterations and the D-scale search of one run:
     ``(best, history, stop_reason, abandoned)``, ``best = (mu_peak, K, index)`` on the
     design grid (``setup.dk_struct``'s µ), nothing certified on the dense grid yet.
 
-    ``trial`` (D-G-K from the complexified controller, ``complex_candidate="auto"``):
-    the records of the first ``_TRIAL_ITERATIONS`` iterations are held back from
-    ``callback`` until the start is decided, and the loop is ``abandoned`` (its
-    records never reported) where none of them has improved on the first iterate by
+    ``trial`` (D-G-K from the complexified controller, ``complex_candidate="auto"``:
+    that controller's complex µ peak on the design grid): the records of the first
+    ``_TRIAL_ITERATIONS`` iterations are held back from ``callback`` until the start
+    is decided, and the loop is ``abandoned`` (its records never reported) where the
+    first iterate's mixed µ is not below ``trial`` by ``min_improvement`` (at the
+    complex design's peak the real structure leaves the G scalings nothing to take,
+    :data:`_TRIAL_ITERATIONS`), or none of those iterates has improved on the first by
     ``min_improvement``."""
     from .steps import NextPlant
     from .steps.dgstep import MussvStep
@@ -893,7 +907,14 @@ def _dk_loop(setup, steps: DKSteps, given, callback, hinfsyn, t_start: float, *,
         done = done if done is not None or over is None else over
         if done is None and mixed:
             done = _regressed(it, mu_peak, best)
-        if trial and it == _TRIAL_ITERATIONS and over is None and not (
+        if trial is not None and it == 1 and over is None and \
+                not mu_peak < trial * (1 - opts.min_improvement):
+            abandoned = True
+            done = (f"D-G-K from the complexified controller abandoned at iteration 1: its "
+                    f"mixed µ {mu_peak:.4f} is not below its complex µ {trial:.4f} by "
+                    f"{opts.min_improvement:.1%}")
+            logger.info("musyn: %s", done)
+        elif trial is not None and it == _TRIAL_ITERATIONS and over is None and not (
                 best[2] != 1 and best[0] < history[0].mu_peak * (1 - opts.min_improvement)):
             abandoned = True
             done = (f"D-G-K from the complexified controller abandoned at iteration {it}: "
@@ -935,7 +956,7 @@ def _dk_loop(setup, steps: DKSteps, given, callback, hinfsyn, t_start: float, *,
                     record.seconds_k,
                     record.seconds_d, record.seconds_fit)
         if callback is not None and not abandoned:
-            if trial and it < _TRIAL_ITERATIONS and done is None:
+            if trial is not None and it < _TRIAL_ITERATIONS and done is None:
                 held.append(record)  # the start is not decided yet
             else:
                 for rec in held + [record]:
@@ -953,6 +974,12 @@ def _dk_loop(setup, steps: DKSteps, given, callback, hinfsyn, t_start: float, *,
             best = (searched.mu_peak, searched.K, len(history))
             stop_reason += f"; D-scale search to µ {searched.mu_peak:.4f}"
     return best, history, stop_reason, abandoned
+
+
+def _complex_peak(rival: _ComplexRun) -> float:
+    """The complex µ peak on the design grid of the complexified run's controller (its
+    record's: a D-K iterate's, or the D-scale search's)."""
+    return min((rec.mu_peak for rec in rival.history if rec.K is rival.K), default=np.inf)
 
 
 def _regressed(it: int, mu_peak: float, best) -> str | None:
