@@ -522,12 +522,12 @@ def test_auto_goes_on_from_the_complexified_controller_where_its_first_k_step_im
     """``complex_candidate="auto"`` (the default): D-G-K starts from the complexified
     controller; its first iterate is reported 10 % below its mixed µ (so below the
     controller's complex µ: the start is tried) and its second at 45 % (an
-    improvement), so that start is kept: one mixed phase only, its first iterate the complexified controller,
-    every record reported to the callback once decided.  Its third iterate, reported as
-    it is (more than ``_DGK_REGRESSION`` above the halved best), ends D-G-K before
-    ``max_iter``.  The result is certified apart: its mixed µ (LMI bound, recomputed here)
-    is no higher than the complexified controller's on the same grid (issue 64's
-    invariant)."""
+    improvement), so that start is kept: one mixed phase only, its first iterate the
+    complexified controller, every record reported to the callback once decided.  Its
+    third iterate, reported as it is (more than ``_DGK_REGRESSION`` above the best as
+    reported), ends D-G-K before ``max_iter``.  The result is certified apart: its mixed
+    µ (LMI bound, recomputed here) is no higher than the complexified controller's on
+    the same grid (issue 64's invariant)."""
     from lmi_suspension.mu.steps import DKSteps
 
     _coarse_dense_grid(monkeypatch)
@@ -547,7 +547,8 @@ def test_auto_goes_on_from_the_complexified_controller_where_its_first_k_step_im
 
 
 @pytest.mark.parametrize("factors", [(0.9, 2.0), (1.5,)])
-def test_auto_abandons_the_complexified_start_where_it_does_not_improve(monkeypatch, factors):
+def test_auto_abandons_the_complexified_start_where_it_does_not_improve(monkeypatch,
+                                                                         factors):
     """``complex_candidate="auto"``: the start from the complexified controller is
     abandoned where its second iterate (its first K-step) is reported at twice its µ,
     after that iterate; or where its first iterate is reported at 1.5 times its mixed µ

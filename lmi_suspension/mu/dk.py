@@ -288,12 +288,15 @@ class MusynOptions:
         Neither start wins on both.  ``"auto"`` (the default): D-G-K starts from the
         complexified controller, and goes on from there where one of its first
         ``_TRIAL_ITERATIONS`` iterates improves on that controller's mixed µ by
-        ``min_improvement`` on the design grid; where none does, that start is
-        abandoned (its records in ``complex_run.start_history``, not reported to
-        ``callback``; the records of a start kept are reported once it is decided) and
-        D-G-K starts as with ``"keep"``: the seat 2.6063 (31 states) in 2.1 times the
-        complexified run's CPU, the two-mass plant 1.6089 (abandoned at 1.8110) in 3.05
-        times (2026-12-02, ``benchmarks/HISTORY.md``).  With ``K0``, the complexified
+        ``min_improvement`` on the design grid.  That start is abandoned at once where
+        the controller's mixed µ is not below its complex µ by ``min_improvement`` (G = 0
+        is then optimal at its peak, and the first D-G-K plant is the one complex D-K
+        stalled on), or after those iterates where none improved; its records are then
+        in ``complex_run.start_history`` (not reported to ``callback``; a kept start's
+        are reported once it is decided), and D-G-K starts as with ``"keep"``.  The seat:
+        start kept, 2.6063 (31 states) in 2.1 times the complexified run's CPU; the
+        two-mass plant: abandoned at once (mixed 1.7779, complex 1.7787), 1.6089
+        (2026-12-02, ``benchmarks/HISTORY.md``).  With ``K0``, the complexified
         run and the start of ``"keep"`` are from it.
     max_gfit_poles : int or None
         D-G-K: the largest basis of the G-scalings (poles per real block; each adds
@@ -358,8 +361,8 @@ class MusynOptions:
         if int(self.dscale_search) < 0:
             raise ParameterError(f"dscale_search must be >= 0, got {self.dscale_search!r}")
         if self.complex_candidate not in ("auto", "keep", "start", None):
-            raise ParameterError(f"complex_candidate must be 'auto', 'keep', 'start' or None, got "
-                                 f"{self.complex_candidate!r}")
+            raise ParameterError(f"complex_candidate must be 'auto', 'keep', 'start' or None, "
+                                 f"got {self.complex_candidate!r}")
         if self.max_gfit_poles is not None and int(self.max_gfit_poles) < 1:
             raise ParameterError(f"max_gfit_poles must be >= 1, got {self.max_gfit_poles!r}")
         if self.time_budget is not None and not (
@@ -986,7 +989,8 @@ def _regressed(it: int, mu_peak: float, best) -> str | None:
     """Why D-G-K stops after iterate ``it``, or None: its µ is more than
     ``_DGK_REGRESSION`` above the best iterate's.  D-G-K's next plant is built around
     the loop it has (no restart from the best, as D-K's over-relaxation has), and after
-    such a step none of the measured paths came back below its best (:data:`_DGK_REGRESSION`)."""
+    such a step none of the measured paths came back below its best
+    (:data:`_DGK_REGRESSION`)."""
     if best[2] == it or not mu_peak > best[0] * (1.0 + _DGK_REGRESSION):
         return None
     done = (f"D-G-K iterate {it} (µ {mu_peak:.4f}) is more than {_DGK_REGRESSION:.0%} above "
