@@ -294,7 +294,7 @@ class MusynOptions:
         stalled on), or after those iterates where none improved; its records are then
         in ``complex_run.start_history`` (not reported to ``callback``; a kept start's
         are reported once it is decided), and D-G-K starts as with ``"keep"``.  The seat:
-        start kept, 2.6063 (31 states) in 2.1-2.3 times the complexified run's CPU; the
+        start kept, 2.6063 (31 states) in about 2.2 times the complexified run's CPU; the
         two-mass plant: abandoned at once (mixed 1.7779, complex 1.7787), 1.6089
         (2026-12-02, ``benchmarks/HISTORY.md``).  With ``K0``, the complexified
         run and the start of ``"keep"`` are from it.
