@@ -69,6 +69,9 @@ if __name__ == "__main__":
         print(f"complexified run: {res.complex_run.seconds:.1f} s (wall), complex µ per iterate "
               f"{[round(h.mu_peak, 4) for h in res.complex_run.history]}, its mixed µ "
               f"{res.complex_run.mu_peak}")
+        if res.complex_run.start_history:
+            print(f"D-G-K from the complexified controller, abandoned: µ per iterate "
+                  f"{[round(h.mu_peak, 4) for h in res.complex_run.start_history]}")
     for h in res.history:
         print(h.index, h.stage, f"µ {h.mu_peak:.4f}", f"K {h.controller_order}",
               f"fits {h.dfit_orders}", f"[K {h.seconds_k:.1f} s, D {h.seconds_d:.1f} s, "

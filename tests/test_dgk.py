@@ -142,8 +142,8 @@ def test_musyn_with_real_blocks_kept_real_returns_certified_bounds():
     assert np.all(np.asarray(res.mu.lower) <= np.asarray(res.mu.upper) * (1 + 1e-6))
     assert res.mu.blk.to_blk().tolist() == BLK
     peaks = [h.mu_peak for h in res.history]
-    if res.best_iteration == 0:
-        assert res.K is res.complex_run.K and res.complex_run.mu_peak == res.mu_peak
+    if res.K is res.complex_run.K:  # index 0, or 1 where D-G-K started from it
+        assert res.best_iteration in (0, 1) and res.complex_run.mu_peak == res.mu_peak
         assert "the complexified D-K's controller is returned" in res.stop_reason
     else:
         assert res.best_iteration == int(np.argmin(peaks)) + 1
@@ -425,9 +425,9 @@ def test_the_complexified_controller_is_kept_where_dgk_certifies_higher(monkeypa
     """Injection: in the D-G-K phase, from iteration 2 on, the K-step returns a worse
     controller (the central H∞ one at twice the optimal level) and the D/G-step reports
     half its µ, so the loop takes it for its best.  The dense-grid certificate, computed
-    apart from the steps, finds it above the complexified D-K's controller (the
-    default ``complex_candidate="keep"``), which must then be returned, and the result
-    says so."""
+    apart from the steps, finds it above the complexified D-K's controller
+    (``complex_candidate="keep"``), which must then be returned, and the result says
+    so."""
     from dataclasses import replace
 
     from lmi_suspension import HinfsynOptions
@@ -459,7 +459,7 @@ def test_the_complexified_controller_is_kept_where_dgk_certifies_higher(monkeypa
             return here
 
     res = musyn(P, 1, 1, BLK, omega=_QUICK_W, steps=DKSteps(kstep=Worse, dgstep=Lying),
-                options=MusynOptions(max_iter=2, **_QUICK))
+                options=MusynOptions(max_iter=2, complex_candidate="keep", **_QUICK))
     assert [h.K is poor for h in res.history] == [False, True]  # the injection took hold
     assert res.best_iteration == 0 and res.K is res.complex_run.K
     assert "complexified D-K's controller is returned" in res.stop_reason
@@ -475,6 +475,118 @@ def test_the_complexified_controller_is_kept_where_dgk_certifies_higher(monkeypa
     again = mussv(freqresp(_mu_part(lft(P, res.K), struct), dense), struct, omega=dense,
                   method="lmi")
     assert float(np.max(again.upper)) == pytest.approx(res.mu_peak, rel=2e-3)  # LMI tol
+
+
+def _steered_dg_step(factors, made):
+    """A D/G-step factory whose instances of the mixed phase report µ scaled by
+    ``factors[i][iteration - 1]`` (their i-th instance: each ``_dk_loop`` builds its
+    own), and records each mixed instance's controllers in ``made``."""
+    from dataclasses import replace
+
+    from lmi_suspension.mu.steps.dgstep import MussvStep
+
+    class Steered(MussvStep):
+        def __init__(self, setup):
+            super().__init__(setup)
+            self.calls = []
+            if setup.mixed:
+                made.append(self.calls)
+                self.factors = factors[len(made) - 1] if len(made) <= len(factors) else ()
+
+        def __call__(self, CL, K):
+            here = super().__call__(CL, K)
+            if not self.setup.mixed:
+                return here
+            self.calls.append(K)
+            f = self.factors[len(self.calls) - 1] if len(self.calls) <= len(self.factors) \
+                else 1.0
+            return replace(here, mu_peak=here.mu_peak * f, upper=here.upper * f,
+                           lower_peak=min(here.lower_peak, here.mu_peak * f))
+
+    return Steered
+
+
+def _mixed_mu(P, K, omega):
+    """Mixed µ upper bound peak of ``F_l(P, K)`` on ``omega`` by the LMI (no AB13MD,
+    no musyn code)."""
+    from lmi_suspension.mu.bounds import MussvOptions
+
+    struct = BlockStructure.coerce(BLK)
+    mu = mussv(freqresp(_mu_part(lft(P, K), struct), omega), struct, omega=omega,
+               method="lmi", options=MussvOptions(compute_lower=False))
+    return float(np.max(mu.upper))
+
+
+def test_auto_goes_on_from_the_complexified_controller_where_its_first_k_step_improves(
+        monkeypatch):
+    """``complex_candidate="auto"`` (the default): D-G-K starts from the complexified
+    controller; its first iterate is reported 10 % below its mixed µ (so below the
+    controller's complex µ: the start is tried) and its second at 45 % (an
+    improvement), so that start is kept: one mixed phase only, its first iterate the
+    complexified controller, every record reported to the callback once decided.  Its
+    third iterate, reported as it is (more than ``_DGK_REGRESSION`` above the best as
+    reported), ends D-G-K before ``max_iter``.  The result is certified apart: its mixed
+    µ (LMI bound, recomputed here) is no higher than the complexified controller's on
+    the same grid (issue 64's invariant)."""
+    from lmi_suspension.mu.steps import DKSteps
+
+    _coarse_dense_grid(monkeypatch)
+    P = oscillator()
+    made, seen = [], []
+    res = musyn(P, 1, 1, BLK, omega=_QUICK_W, callback=seen.append,
+                steps=DKSteps(dgstep=_steered_dg_step([(0.9, 0.45)], made)),
+                options=MusynOptions(max_iter=4, max_dfit_order=1, **_QUICK))
+    assert len(made) == 1  # no D-G-K from the beginning
+    assert made[0][0] is res.complex_run.K and res.history[0].K is res.complex_run.K
+    assert seen == list(res.history) and not res.complex_run.start_history
+    assert len(res.history) == 3 and "more than 2% above the best" in res.stop_reason
+    assert np.all(res.CL.poles().real < 0) and res.mu_lower_peak <= res.mu_peak
+    dense = res.mu.omega
+    assert _mixed_mu(P, res.K, dense) == pytest.approx(res.mu_peak, rel=2e-3)  # LMI tol
+    assert res.mu_peak <= _mixed_mu(P, res.complex_run.K, dense) * (1 + 2e-3)
+
+
+@pytest.mark.parametrize("factors", [(0.9, 2.0), (1.5,)])
+def test_auto_abandons_the_complexified_start_where_it_does_not_improve(monkeypatch,
+                                                                         factors):
+    """``complex_candidate="auto"``: the start from the complexified controller is
+    abandoned where its second iterate (its first K-step) is reported at twice its µ,
+    after that iterate; or where its first iterate is reported at 1.5 times its mixed µ
+    (then above the controller's complex µ: G = 0 is optimal at its peak), at once.  Its
+    records are kept in ``complex_run.start_history``, not reported, and D-G-K starts
+    from the beginning (a second mixed phase, whose first controller is its own
+    K-step's).  The result is certified apart and no worse than the complexified
+    controller."""
+    from lmi_suspension.mu.steps import DKSteps
+
+    _coarse_dense_grid(monkeypatch)
+    P = oscillator()
+    made, seen = [], []
+    res = musyn(P, 1, 1, BLK, omega=_QUICK_W, callback=seen.append,
+                steps=DKSteps(dgstep=_steered_dg_step([factors], made)),
+                options=MusynOptions(max_iter=2, max_dfit_order=1, **_QUICK))
+    assert len(made) == 2 and len(made[0]) == len(factors)
+    trial = res.complex_run.start_history
+    assert len(trial) == len(factors) and trial[0].K is res.complex_run.K
+    assert f"abandoned at iteration {len(factors)}" in res.stop_reason
+    assert seen == list(res.history) and res.history[0].K is not res.complex_run.K
+    assert all(rec.K is not K for rec in res.history for K in made[0])
+    assert np.all(res.CL.poles().real < 0) and res.mu_lower_peak <= res.mu_peak
+    dense = res.mu.omega
+    assert _mixed_mu(P, res.K, dense) == pytest.approx(res.mu_peak, rel=2e-3)
+    assert res.mu_peak <= _mixed_mu(P, res.complex_run.K, dense) * (1 + 2e-3)
+
+
+def test_dgk_stops_after_an_iterate_past_the_regression_bound():
+    """``_regressed``: the best iterate itself and one within ``_DGK_REGRESSION`` of the
+    best go on; one above it stops D-G-K, saying which iterates."""
+    from lmi_suspension.mu import dk
+
+    best = (1.6085, None, 5)
+    assert dk._regressed(5, 1.6085, best) is None
+    assert dk._regressed(6, 1.6085 * (1 + 0.99 * dk._DGK_REGRESSION), best) is None
+    said = dk._regressed(6, 1.7507, best)
+    assert "iterate 6 (µ 1.7507)" in said and "iterate 5 (1.6085)" in said
 
 
 def test_a_time_budget_ends_both_phases_after_their_first_iterate_and_says_so(monkeypatch):

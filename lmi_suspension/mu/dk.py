@@ -272,7 +272,7 @@ class MusynOptions:
         ``tests/test_dgk.py`` (±50 % real stiffness, 40-point grid, no D-scale search;
         2026-11-27): complex D-K ends at mixed µ 1.1326, D-G-K at 1.0069 (iteration 5;
         ``benchmarks/bench_dgk.py``, figures in ``docs/guide/dk.md``).
-    complex_candidate : {"keep", "start"} or None
+    complex_candidate : {"auto", "keep", "start"} or None
         D-G-K only (real blocks kept real): first run the complexified D-K
         (``complexify=True``, the same options; its D-scale search included, its
         dense-grid certificate not), then D-G-K, and return whichever controller
@@ -289,7 +289,8 @@ class MusynOptions:
         failed (1.7778, the complexified controller, in 93 s against 162 s); on the
         oscillator of ``tests/test_dgk.py`` 1.0659 against 1.0391, both in about 60 s
         (complexified D-K: 1.7778 in 68 s and 1.1140 in 44 s).  ``stop_reason`` says which
-        controller is returned (``best_iteration`` 0: the complexified run's) and
+        controller is returned (``best_iteration`` 0: the complexified run's; 1 where
+        D-G-K started from it) and
         :attr:`MusynResult.complex_run` holds that run (its records do not go to
         ``callback``).  ``None``: D-G-K alone, which
         can end above complex D-K (the seat over m3 and k1: 2.734 against 2.671,
@@ -300,8 +301,19 @@ class MusynOptions:
         two-mass ``"keep"`` 1.6089 (25 states), ``"start"`` 1.7779 (the complexified
         controller; D-G-K's second iterate 1.8110); seat ``"keep"`` 2.6711 (the
         complexified controller; D-G-K's own 2.7546), ``"start"`` 2.6063 (31 states).
-        Neither start wins on both, so the default stays ``"keep"``.  With ``K0``, the
-        complexified run starts from it.
+        Neither start wins on both.  ``"auto"`` (the default): D-G-K starts from the
+        complexified controller, and goes on from there where one of its first
+        ``_TRIAL_ITERATIONS`` iterates improves on that controller's mixed µ by
+        ``min_improvement`` on the design grid.  That start is abandoned at once where
+        the controller's mixed µ is not below its complex µ by ``min_improvement`` (G = 0
+        is then optimal at its peak, and the first D-G-K plant is the one complex D-K
+        stalled on), or after those iterates where none improved; its records are then
+        in ``complex_run.start_history`` (not reported to ``callback``; a kept start's
+        are reported once it is decided), and D-G-K starts as with ``"keep"``.  The seat:
+        start kept, 2.6063 (31 states) in about 2.2 times the complexified run's CPU; the
+        two-mass plant: abandoned at once (mixed 1.7779, complex 1.7787), 1.6089
+        (2026-12-02, ``benchmarks/HISTORY.md``).  With ``K0``, the complexified
+        run and the start of ``"keep"`` are from it.
     max_gfit_poles : int or None
         D-G-K: the largest basis of the G-scalings (poles per real block; each adds
         three states to the scaled plant per real channel, so this bounds the order of
@@ -339,7 +351,7 @@ class MusynOptions:
     dscale_overrelax: float = 2.0
     dscale_search: int = 200
     complexify: bool = False
-    complex_candidate: str | None = "keep"
+    complex_candidate: str | None = "auto"
     max_gfit_poles: int | None = None
     time_budget: float | None = None
 
@@ -364,9 +376,9 @@ class MusynOptions:
                                  f"{self.dscale_overrelax!r}")
         if int(self.dscale_search) < 0:
             raise ParameterError(f"dscale_search must be >= 0, got {self.dscale_search!r}")
-        if self.complex_candidate not in ("keep", "start", None):
-            raise ParameterError(f"complex_candidate must be 'keep', 'start' or None, got "
-                                 f"{self.complex_candidate!r}")
+        if self.complex_candidate not in ("auto", "keep", "start", None):
+            raise ParameterError(f"complex_candidate must be 'auto', 'keep', 'start' or None, "
+                                 f"got {self.complex_candidate!r}")
         if self.max_gfit_poles is not None and int(self.max_gfit_poles) < 1:
             raise ParameterError(f"max_gfit_poles must be >= 1, got {self.max_gfit_poles!r}")
         if self.time_budget is not None and not (
@@ -482,7 +494,9 @@ class MusynResult:
         plant: one of the two certificates is then wrong).
     best_iteration : int
         Index of the iteration whose controller is returned; 0 where it is the
-        complexified run's (``MusynOptions.complex_candidate``, ``complex_run.K``).
+        complexified run's (``MusynOptions.complex_candidate``, ``complex_run.K``), or 1
+        where D-G-K started from that controller (``"start"``, or ``"auto"`` with the
+        start kept: its first iterate).
     stop_reason : str
         Why the loop stopped.
     reduced_from : int or None
@@ -546,6 +560,12 @@ class _ComplexRun:
         Its controller's mixed µ peak on the dense grid, where the final comparison
         computed it (None where D-G-K's result was already no higher than that
         controller's mixed µ lower bound on the design grid).
+    start_history : tuple of MusynIteration
+        ``complex_candidate="auto"``: the records of D-G-K from this controller where
+        that start was abandoned (its first record is this controller's mixed µ on the
+        design grid; not reported to ``callback``), else empty.
+    start_stop : str or None
+        Why that start was abandoned.
     """
 
     K: control.StateSpace
@@ -553,6 +573,8 @@ class _ComplexRun:
     stop_reason: str
     seconds: float
     mu_peak: float | None = None
+    start_history: tuple = ()
+    start_stop: str | None = None
 
 
 def default_omega(P, n: int = 60) -> np.ndarray:
@@ -584,6 +606,28 @@ def _complexified(struct: BlockStructure) -> BlockStructure:
         rows.append([1, 1] if (r, c) == (1, 0) else [r, c])
     return BlockStructure.from_blk(rows)
 
+
+#: ``complex_candidate="auto"``: the iterates of D-G-K from the complexified controller
+#: (the first is that controller) within which one must improve on it, or that start is
+#: abandoned for D-G-K from the beginning.  Its second iterate is its first K-step: on
+#: the seat over m3 and k1 it went from 2.6704 to 2.5827, where the run ended (2.6063 on
+#: the dense grid); on the two-mass plant from 1.7779 to 1.8110, and D-G-K from the
+#: beginning reached 1.6085 (design grid, 2026-12-02, ``benchmarks/musyn_mixed.py``).
+#: Before that K-step the start is abandoned where the first iterate's mixed µ is not
+#: below the controller's complex µ by ``min_improvement``: where they are equal at the
+#: peak, G = 0 is already an optimal scaling there and the first D-G-K plant is the one
+#: complex D-K stalled on.  The two-mass controller: complex 1.7787, mixed 1.7779 (0.04 %
+#: below; its K-step then went up to 1.8110); the seat's: 2.6975 and 2.6704 (1.0 % below;
+#: down to 2.5827)
+_TRIAL_ITERATIONS = 2
+#: D-G-K stops after an iterate whose µ peak is this much above the best iterate's
+#: (:func:`_regressed`).  Measured 2026-12-02 (``benchmarks/musyn_mixed.py``): the
+#: two-mass plant's iterates 1.6085 (best), 1.7507 (+8.8 %), 1.7018; the seat's from
+#: the complexified controller 2.5827 (best), 2.6512 (+2.7 %), 2.7123: patience (2)
+#: spent one more iterate each, 7 and 2 s of CPU, and the regressions were 2.7 % and
+#: more, the small steps of a converging path (seat from the beginning: 0.1-1.2 %)
+#: below them
+_DGK_REGRESSION = 0.02
 
 #: frequencies whose upper bound the final µ refines at a time (see _final_bounds)
 _REFINE_BATCH = 8
@@ -798,24 +842,49 @@ def musyn(P, nmeas: int, ncon: int, blk=None, *, omega=None, options: MusynOptio
         # controller is a candidate D-G-K must beat ("start": D-G-K starts from it)
         cx_setup = replace(setup, mixed=False, dk_struct=_complexified(setup.struct),
                            options=replace(setup.options, complexify=True))
-        cx_best, cx_history, cx_stop = _dk_loop(cx_setup, steps, given, None, hinfsyn,
-                                                t_start)
+        cx_best, cx_history, cx_stop, _ = _dk_loop(cx_setup, steps, given, None, hinfsyn,
+                                                   t_start)
         rival = _ComplexRun(K=cx_best[1], history=tuple(cx_history), stop_reason=cx_stop,
                               seconds=time.perf_counter() - t_start)
         logger.info("musyn: complexified D-K ended at complex µ %.4f in %.1f s (%s)",
                     cx_best[0], rival.seconds, cx_stop)
-    if rival is not None and mode == "start":
-        given = _GivenController(rival.K, float(hinfnorm(mu_part(lft(setup.G, rival.K),
-                                                                  setup.struct))[0]),
-                                 ("the complexified D-K's controller: no K-step",))
-    best, history, stop_reason = _dk_loop(setup, steps, given, callback, hinfsyn, t_start)
-    return _certified(setup, best, history, stop_reason, t_start, rival=rival)
+    started = rival is not None and mode in ("start", "auto")
+    if started:
+        from_complex = _GivenController(
+            rival.K, float(hinfnorm(mu_part(lft(setup.G, rival.K), setup.struct))[0]),
+            ("the complexified D-K's controller: no K-step",))
+        best, history, stop_reason, abandoned = _dk_loop(
+            setup, steps, from_complex, callback, hinfsyn, t_start,
+            trial=_complex_peak(rival) if mode == "auto" else None)
+        if abandoned:
+            # the start from the complexified controller did not improve on it: D-G-K
+            # from the beginning (its own first K-step, or K0); the complexified
+            # controller's mixed µ on the design grid is the trial's first iterate
+            rival = replace(rival, start_history=tuple(history), start_stop=stop_reason)
+            started = False
+            best, history, stop_reason, _ = _dk_loop(setup, steps, given, callback, hinfsyn,
+                                                     t_start)
+    else:
+        best, history, stop_reason, _ = _dk_loop(setup, steps, given, callback, hinfsyn,
+                                                 t_start)
+    return _certified(setup, best, history, stop_reason, t_start, rival=rival,
+                      started=started)
 
 
-def _dk_loop(setup, steps: DKSteps, given, callback, hinfsyn, t_start: float):
+def _dk_loop(setup, steps: DKSteps, given, callback, hinfsyn, t_start: float, *,
+             trial: float | None = None):
     """The D-K (or D-G-K) iterations and the D-scale search of one run:
-    ``(best, history, stop_reason)``, ``best = (mu_peak, K, index)`` on the design grid
-    (``setup.dk_struct``'s µ), nothing certified on the dense grid yet."""
+    ``(best, history, stop_reason, abandoned)``, ``best = (mu_peak, K, index)`` on the
+    design grid (``setup.dk_struct``'s µ), nothing certified on the dense grid yet.
+
+    ``trial`` (D-G-K from the complexified controller, ``complex_candidate="auto"``:
+    that controller's complex µ peak on the design grid): the records of the first
+    ``_TRIAL_ITERATIONS`` iterations are held back from ``callback`` until the start
+    is decided, and the loop is ``abandoned`` (its records never reported) where the
+    first iterate's mixed µ is not below ``trial`` by ``min_improvement`` (at the
+    complex design's peak the real structure leaves the G scalings nothing to take,
+    :data:`_TRIAL_ITERATIONS`), or none of those iterates has improved on the first by
+    ``min_improvement``."""
     from .steps import NextPlant
     from .steps.dgstep import MussvStep
     from .steps.fit import default_fit
@@ -832,6 +901,8 @@ def _dk_loop(setup, steps: DKSteps, given, callback, hinfsyn, t_start: float):
     fitstep = (steps.fit or default_fit)(setup)
 
     history: list[MusynIteration] = []
+    held: list[MusynIteration] = []  # a trial's records, until it is decided
+    abandoned = False
     best = None  # (mu_peak, K, index)
     searched = None  # the D-scale search's record, from iteration 1's D-step
     stop_reason = f"reached max_iter={opts.max_iter}"
@@ -882,6 +953,21 @@ def _dk_loop(setup, steps: DKSteps, given, callback, hinfsyn, t_start: float):
         over = _over_budget(opts, t_start, t0 if t_last is None else t_last, it, best[2])
         t_last = t0
         done = done if done is not None or over is None else over
+        if done is None and mixed:
+            done = _regressed(it, mu_peak, best)
+        if trial is not None and it == 1 and over is None and \
+                not mu_peak < trial * (1 - opts.min_improvement):
+            abandoned = True
+            done = (f"D-G-K from the complexified controller abandoned at iteration 1: its "
+                    f"mixed µ {mu_peak:.4f} is not below its complex µ {trial:.4f} by "
+                    f"{opts.min_improvement:.1%}")
+            logger.info("musyn: %s", done)
+        elif trial is not None and it == _TRIAL_ITERATIONS and over is None and not (
+                best[2] != 1 and best[0] < history[0].mu_peak * (1 - opts.min_improvement)):
+            abandoned = True
+            done = (f"D-G-K from the complexified controller abandoned at iteration {it}: "
+                    f"µ {mu_peak:.4f} against its start's {history[0].mu_peak:.4f}")
+            logger.info("musyn: %s", done)
 
         # the D-scale search starts from this D-step, so it runs now, and the D-K
         # iterations after it measure their progress against it; its own copy of the
@@ -917,8 +1003,13 @@ def _dk_loop(setup, steps: DKSteps, given, callback, hinfsyn, t_start: float):
                     gamma_prev, mu_peak, record.mu_lower_peak, K.nstates, orders,
                     record.seconds_k,
                     record.seconds_d, record.seconds_fit)
-        if callback is not None:
-            callback(record)
+        if callback is not None and not abandoned:
+            if trial is not None and it < _TRIAL_ITERATIONS and done is None:
+                held.append(record)  # the start is not decided yet
+            else:
+                for rec in held + [record]:
+                    callback(rec)
+                held = []
         if done is not None:
             stop_reason = done
             break
@@ -930,7 +1021,27 @@ def _dk_loop(setup, steps: DKSteps, given, callback, hinfsyn, t_start: float):
         if _search_wins(searched, history[best[2] - 1], setup):
             best = (searched.mu_peak, searched.K, len(history))
             stop_reason += f"; D-scale search to µ {searched.mu_peak:.4f}"
-    return best, history, stop_reason
+    return best, history, stop_reason, abandoned
+
+
+def _complex_peak(rival: _ComplexRun) -> float:
+    """The complex µ peak on the design grid of the complexified run's controller (its
+    record's: a D-K iterate's, or the D-scale search's)."""
+    return min((rec.mu_peak for rec in rival.history if rec.K is rival.K), default=np.inf)
+
+
+def _regressed(it: int, mu_peak: float, best) -> str | None:
+    """Why D-G-K stops after iterate ``it``, or None: its µ is more than
+    ``_DGK_REGRESSION`` above the best iterate's.  D-G-K's next plant is built around
+    the loop it has (no restart from the best, as D-K's over-relaxation has), and after
+    such a step none of the measured paths came back below its best
+    (:data:`_DGK_REGRESSION`)."""
+    if best[2] == it or not mu_peak > best[0] * (1.0 + _DGK_REGRESSION):
+        return None
+    done = (f"D-G-K iterate {it} (µ {mu_peak:.4f}) is more than {_DGK_REGRESSION:.0%} above "
+            f"the best, iterate {best[2]} ({best[0]:.4f})")
+    logger.info("musyn: %s", done)
+    return done
 
 
 def _search_wins(searched: MusynIteration, dk_best: MusynIteration, setup) -> bool:
@@ -963,7 +1074,7 @@ def _search_applies(setup, best) -> bool:
 
 
 def _certified(setup, best, history, stop_reason: str, t_start: float,
-               rival: _ComplexRun | None = None) -> MusynResult:
+               rival: _ComplexRun | None = None, started: bool = False) -> MusynResult:
     """The best iterate's result: its µ on a dense grid with the true structure (the
     peak refined with the LMI bound, bounded between grid points), its controller
     reduced where asked and µ allows, its constraints recomputed."""
@@ -973,7 +1084,7 @@ def _certified(setup, best, history, stop_reason: str, t_start: float,
         CL_full, CL, dense, final = _dense_certificate(setup, K, history[best_it - 1].peak_omega)
     else:
         (K, best_it, CL_full, CL, dense, final, stop_reason,
-         rival) = _against_complex(setup, rival, history, best, stop_reason)
+         rival) = _against_complex(setup, rival, history, best, stop_reason, started)
     checks: tuple = ()
     mu_bound = float("inf")
     scaled = None  # the best iterate's scaled plant, where its γ bounds µ
@@ -1077,7 +1188,8 @@ def _refine_peaks(CL, struct: BlockStructure, omega: np.ndarray, mu, rng):
                                 warnings=tuple(mu.warnings) + tuple(more.warnings), **fields)
 
 
-def _against_complex(setup, rival: _ComplexRun, history, best, stop_reason: str):
+def _against_complex(setup, rival: _ComplexRun, history, best, stop_reason: str,
+                     started: bool):
     """D-G-K's best controller against the complexified D-K's (``complex_candidate``),
     both certified with mixed µ on the dense grid: the lower is returned.  Returns
     ``(K, best_iteration, CL_full, CL, dense, final, stop_reason, rival)`` of the chosen
@@ -1089,10 +1201,12 @@ def _against_complex(setup, rival: _ComplexRun, history, best, stop_reason: str)
     the other only where that certified peak is above the other's µ lower bound on the
     design grid (below it, the other's µ cannot be lower)."""
     _, K, best_it = best
-    started = setup.options.complex_candidate == "start"
     mine = history[best_it - 1]
     if started:
         theirs = history[0]  # D-G-K's first iterate is the complexified run's controller
+    elif rival.start_history:  # the abandoned start's first iterate: the same loop
+        theirs = replace(rival.start_history[0], index=0)
+        stop_reason += f"; {rival.start_stop}"
     else:  # its mixed µ on the design grid, as D-G-K's D/G-step takes it
         from .steps.dgstep import MussvStep
 
