@@ -568,15 +568,16 @@ def compare(rows, *, n_stability, n_performance, mu, search_n, ref_file, omega=N
     print(f"\ncomparison: {time.perf_counter() - t0:.0f} s")
 
 
-def certify(path, *, n_stability=10_000, n_performance=24, search_n=50):
+def certify(path, *, n_stability=10_000, n_performance=24, search_n=50, store=False):
     """Item 3's certificate of the shipped table (:func:`certify_scheduled`): every
     stability sample at its estimated mass (true ± ERROR, seeded), the road figures, and
-    per bin mixed µ of robust stability and the worst-seat search; prints it."""
+    per bin mixed µ of robust stability and the worst-seat search; prints it, and with
+    ``store`` writes it into the file's ``metadata["certificate"]`` (controllers unchanged)."""
     from lmi_suspension.io import load_controller
     from lmi_suspension.seat.occupants import occupant_samples
     from lmi_suspension.seat.scheduled import certify_scheduled
 
-    Ks, _ = load_controller(path)
+    Ks, meta = load_controller(path)
     t0 = time.perf_counter()
     samples = occupant_samples(rng=np.random.default_rng(SAMPLE_SEED),
                                n_stability=n_stability, n_performance=n_performance)
@@ -597,7 +598,50 @@ def certify(path, *, n_stability=10_000, n_performance=24, search_n=50):
         print(f"| {v.estimates[0]:g}-{v.estimates[1]:g} | {v.occupants.m3[0]:g}-"
               f"{v.occupants.m3[1]:g} | {v.rs_mu:.4f} | {lower:.4f} | {w['u'].value:.0f} N | "
               f"{w['x1'].value:.4f} m | {v.controller_radius:.0f} rad/s |")
+    if store:
+        from lmi_suspension.io import save_scheduled_controller
+
+        meta = dict(meta)
+        meta["certificate"] = _certificate_metadata(c, n_performance, search_n)
+        save_scheduled_controller(path, Ks, metadata=meta)
+        print(f"certificate stored in {path}'s metadata")
     return c
+
+
+def _certificate_metadata(c, n_performance: int, search_n: int) -> dict:
+    """:func:`certify`'s figures as the table file's ``metadata["certificate"]``."""
+    targets = []
+    if c.u_searched > HOLD_U or c.x1_searched > HOLD_X1:
+        targets.append(f"the search finds {c.u_searched:.0f} N and {c.x1_searched:.4f} m "
+                       f"(bounds {HOLD_U:g} N, {HOLD_X1:g} m)")
+    if c.nominal_ratio > 1.5 or c.worst_ratio > 1.8:
+        targets.append("nominal and worst ratio above the targets 1.5 and 1.8")
+    bins = []
+    for v in c.values:
+        w = {x.figure: x for x in v.worst_seats}
+        bins.append({"estimates": [float(x) for x in v.estimates],
+                     "true_m3": [float(x) for x in v.occupants.m3],
+                     "rs_mu": round(float(v.rs_mu), 4),
+                     "rs_lower": (round(float(v.mu.rs_lower), 4) if v.mu is not None
+                                  else None),
+                     "u_searched": round(float(w["u"].value), 1),
+                     "x1_searched": round(float(w["x1"].value), 4),
+                     "pole": round(float(v.controller_radius))})
+    return {"command": "python benchmarks/scheduled_tuned.py --certify --store "
+                       f"(certify_scheduled: occupant_samples seed {SAMPLE_SEED}, "
+                       f"{c.n_stability} stability and {n_performance} performance "
+                       f"samples; estimates true ± {ERROR:g} kg drawn from "
+                       f"default_rng({ESTIMATE_SEED}); per bin occupant_mu and "
+                       f"worst_bump_seats with {search_n} samples)",
+            "unstable": int(c.unstable), "n_stability": int(c.n_stability),
+            "nominal_ratio": round(float(c.nominal_ratio), 3),
+            f"worst_ratio_{n_performance}_samples": round(float(c.worst_ratio), 3),
+            "u_samples": round(float(c.u_max), 1), "x1_samples": round(float(c.x1_max), 4),
+            "u_searched": round(float(c.u_searched), 1),
+            "x1_searched": round(float(c.x1_searched), 4),
+            "bins": bins, "loop_radius": round(float(c.loop_radius)),
+            "seconds": round(float(c.seconds)),
+            "not_met": "; ".join(targets) if targets else None}
 
 
 def main(argv=None):
@@ -614,6 +658,8 @@ def main(argv=None):
     ap.add_argument("--certify", action="store_true",
                     help="item 3's certificate of --out's mu_scheduled.json (10 000 "
                          "stability samples, µ and the search per bin), then stop")
+    ap.add_argument("--store", action="store_true",
+                    help="with --certify: write the certificate into the file's metadata")
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--rows", default=None,
                     help="comparison rows among tuned,convex,robust,single (default all)")
@@ -660,7 +706,7 @@ def main(argv=None):
                     "python benchmarks/scheduled_tuned.py "
                     + " ".join(sys.argv[1:] if argv is None else argv))
     if args.certify:
-        certify(out / "mu_scheduled.json")
+        certify(out / "mu_scheduled.json", store=args.store)
         return
     if args.no_compare:
         return
