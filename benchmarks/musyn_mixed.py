@@ -10,7 +10,12 @@ grid without the D-scale search; ``seat``: the seat over m3 and k1 of
 ``bench_dgk.py``, ``seat_augmented_plant(SeatDesignOptions(include_paper=False))`` on
 ``DEFAULT_OMEGA`` with ``replace(DEFAULT_MUSYN, max_iter=6, patience=2)``: ``seat`` and
 ``seat complexify=True``), the others ``MusynOptions`` keywords (for ``seat``, these
-two included).  Run it under
+two included).  ``--orders`` (``oscillator``, ``seat``): the run at full order
+(``reduce_order=None``), then for each lower order the balanced truncation of its
+controller: mixed µ on the result's dense grid (upper, lower) and by AB13MD's scalings
+on 800 frequencies over 1e-2..3e4 rad/s (independent of ``musyn``), relative to the full
+order's, and the closed loop's largest pole real part
+(:func:`musyn_orders.tradeoff`).  Run it under
 ``ulimit -v 4000000`` and ``timeout``: D-G-K with 10 G poles on the two-mass plant
 (``complex_candidate=None, max_gfit_poles=10``) filled a 4 GB address space at its
 second K-step (2026-12-02).
@@ -24,10 +29,32 @@ import resource
 import sys
 import time
 
+import control
 import numpy as np
 
 from lmi_suspension.examples import stiffness_oscillator, uncertain_two_mass
 from lmi_suspension.mu import MusynOptions, musyn
+
+#: the grid of ``--orders``'s independent certificate, rad/s: the seat's design grid
+#: (0.1-3162 rad/s) and its dense grid's extensions, a decade beyond each end
+CHECK = np.logspace(-2, 4.5, 800)
+
+
+def problem(name: str, kw: dict):
+    """``(P, nmeas, ncon, blk, omega, options)`` of ``oscillator`` and ``seat``."""
+    if name == "oscillator":
+        ex = stiffness_oscillator()
+        return (ex.P, ex.nmeas, ex.ncon, ex.blk, np.logspace(-2, 1.5, 40),
+                MusynOptions(max_iter=8, dscale_search=0, **kw))
+    if name == "seat":
+        from lmi_suspension.seat.augmented import SeatDesignOptions, seat_augmented_plant
+        from lmi_suspension.seat.design import DEFAULT_MUSYN, DEFAULT_OMEGA
+
+        aug = seat_augmented_plant(SeatDesignOptions(include_paper=False))
+        return (aug.P, aug.nmeas, aug.ncon, aug.blk, DEFAULT_OMEGA,
+                replace(DEFAULT_MUSYN, **{"max_iter": 6, "patience": 2, **kw}))
+    raise SystemExit(f"--orders takes oscillator or seat, not {name}")
+
 
 if __name__ == "__main__":
     logging.basicConfig(level=logging.INFO, format="%(relativeCreated)7.0f %(message)s")
@@ -35,28 +62,28 @@ if __name__ == "__main__":
                  "lmi_suspension.mu.dsearch", "lmi_suspension.mu.bounds",
                  "lmi_suspension.mu.gfit"):
         logging.getLogger(name).setLevel(logging.WARNING)
-    problem = sys.argv[1] if len(sys.argv) > 1 else "two_mass"
+    orders = "--orders" in sys.argv
+    args = [a for a in sys.argv[1:] if a != "--orders"]
+    problem_name = args[0] if args else "two_mass"
     kw = {k.strip(): ast.literal_eval(v) for k, v in
-          (item.split("=", 1) for item in sys.argv[2:])}
+          (item.split("=", 1) for item in args[1:])}
     t0, c0 = time.perf_counter(), os.times()
-    if problem == "oscillator":
-        ex = stiffness_oscillator()
-        res = musyn(ex.P, ex.nmeas, ex.ncon, ex.blk, omega=np.logspace(-2, 1.5, 40),
-                    options=MusynOptions(max_iter=8, dscale_search=0, **kw))
-    elif problem == "seat":
-        from lmi_suspension.seat.augmented import SeatDesignOptions, seat_augmented_plant
-        from lmi_suspension.seat.design import DEFAULT_MUSYN, DEFAULT_OMEGA
+    if orders:
+        from musyn_orders import tradeoff
 
-        aug = seat_augmented_plant(SeatDesignOptions(include_paper=False))
-        res = musyn(aug.P, aug.nmeas, aug.ncon, aug.blk, omega=DEFAULT_OMEGA,
-                    options=replace(DEFAULT_MUSYN, **{"max_iter": 6, "patience": 2, **kw}))
+        P, nmeas, ncon, blk, omega, options = problem(problem_name, kw)
+        print(f"{problem_name} {kw}, full order (reduce_order=None), then each order:")
+        res = tradeoff(control.ss(P), nmeas, ncon, blk, omega, options, None, check=CHECK)
+    elif problem_name in ("oscillator", "seat"):
+        P, nmeas, ncon, blk, omega, options = problem(problem_name, kw)
+        res = musyn(P, nmeas, ncon, blk, omega=omega, options=options)
     else:
         res = musyn(uncertain_two_mass(), 1, 1, options=MusynOptions(**kw))
     seconds = time.perf_counter() - t0
     c1 = os.times()  # CPU of this process and its finished children (AB13MD's)
     cpu = sum(getattr(c1, k) - getattr(c0, k) for k in
               ("user", "system", "children_user", "children_system"))
-    print(f"{problem} {kw}: µ {res.mu_peak:.4f} (lower {res.mu_lower_peak:.4f}), "
+    print(f"{problem_name} {kw}: µ {res.mu_peak:.4f} (lower {res.mu_lower_peak:.4f}), "
           f"K order {res.K.nstates}, {seconds:.1f} s (CPU {cpu:.1f} s), best iteration "
           f"{res.best_iteration}, "
           f"peak RSS {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} MB")

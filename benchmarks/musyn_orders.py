@@ -12,6 +12,10 @@ best iterate's D-scaled plant (a µ bound at every frequency: the default order 
 judgement) and µ on the result's dense grid (``dk._final_bounds``), relative to the full
 order's dense-grid µ.
 
+The same table for another problem (mixed µ included: the columns on the D-scaled plant
+are then left out, and AB13MD's certificate of each truncation is added):
+:func:`tradeoff`, e.g. ``python benchmarks/musyn_mixed.py seat --orders``.
+
 ``--dkpy``: then default ``musyn`` and forced orders (``reduce_order=k``,
 ``reduce_mu_tol=0.05``) beside one dkpy run, with their CPU seconds and the ratio to
 dkpy's (see ``musyn_vs_dkpy.py``).
@@ -22,6 +26,7 @@ Run: ``OPENBLAS_NUM_THREADS=1 python benchmarks/musyn_orders.py [--dkpy]``.
 import logging
 import sys
 import warnings
+from dataclasses import replace
 
 import control
 import numpy as np
@@ -33,7 +38,9 @@ from lmi_suspension.lti.plant import GeneralizedPlant, lft
 from lmi_suspension.lti.reduce import balanced_truncation
 from lmi_suspension.lti.scaling import balanced_statespace
 from lmi_suspension.mu import MusynOptions, musyn
+from lmi_suspension.mu.bounds import _ab13md_blocks
 from lmi_suspension.mu.dk import _final_bounds
+from lmi_suspension.mu.steps import mu_part
 from lmi_suspension.umodel.blocks import BlockStructure
 
 OMEGA = np.logspace(-3, 3, 61)
@@ -84,30 +91,73 @@ def weighted_truncation(K, V, order):
     return control.ss(Tl @ Ak @ Tr, Tl @ Bk, Ck @ Tr, Dk)
 
 
-def tradeoff(P, nmeas, ncon):
-    res = musyn(P, nmeas, ncon, BLK, omega=OMEGA, options=MusynOptions(reduce_order=None))
-    best = res.history[res.best_iteration - 1]
-    PD, K, mu = best.PD, res.K, res.mu_peak
+def tradeoff(P, nmeas, ncon, blk=BLK, omega=OMEGA, options=MusynOptions(reduce_order=None),
+             orders=ORDERS, check=None):
+    """Run ``musyn`` (``options``, full order) and print, for each order, µ of the
+    truncations of its controller relative to the full order's dense-grid µ.
+
+    Columns: the balanced truncation's norm on the best D-K iterate's D-scaled plant
+    (a µ bound at every frequency; ``--`` where the structure has real blocks, whose
+    scaled plant holds G scalings, or where the complexified run's controller is
+    returned) and its µ on the result's dense grid (``dk._final_bounds``, mixed µ with
+    real blocks; its lower bound too), the same two for Enns' output-weighted truncation
+    (D-K only), and, with ``check`` (a grid, rad/s), the truncation's µ by AB13MD's
+    scalings on it and at the loop's dense-grid peak (:func:`certified_mu`, independent
+    of ``musyn``), and its closed loop's largest pole real part.  ``orders`` None: every
+    order below the full one.  Returns the result."""
+    from musyn_vs_dkpy import certified_mu
+
+    res = musyn(P, nmeas, ncon, blk, omega=omega, options=replace(options, reduce_order=None))
+    K, mu = res.K, res.mu_peak
     G = GeneralizedPlant.from_statespace(P, nmeas, ncon)
-    struct = BlockStructure.from_blk(BLK)
-    V = output_weight(PD, K, nmeas, ncon)
-    print(f"full order {K.nstates}: µ {mu:.6f}, norm on its scaled plant {best.gamma:.6f}")
+    struct = BlockStructure.from_blk(blk)
+    best = res.history[res.best_iteration - 1] if res.best_iteration >= 1 else None
+    PD = None if struct.has_real or best is None else best.PD
+    V = None if PD is None else output_weight(PD, K, nmeas, ncon)
+    ab_blocks = _ab13md_blocks(struct)
+    print(f"full order {K.nstates}: µ {mu:.6f} (lower {res.mu_lower_peak:.6f})"
+          + ("" if PD is None else f", norm on its scaled plant {best.gamma:.6f}"))
 
     def judged(K_red):
         CL = lft(G, K_red)
         if np.any(np.real(CL.poles()) >= 0):
-            return np.inf, np.inf
-        norm = float(hinfnorm(lft(PD, K_red, nmeas, ncon))[0])
-        peak = float(np.max(_final_bounds(balanced_statespace(CL), struct, res.mu.omega,
-                                          np.random.default_rng(0)).upper))
-        return norm / mu - 1, peak / mu - 1
+            return np.inf, np.inf, np.inf, None
+        norm = np.nan if PD is None else float(hinfnorm(lft(PD, K_red, nmeas, ncon))[0])
+        bounds = _final_bounds(balanced_statespace(mu_part(CL, struct)), struct,
+                               res.mu.omega, np.random.default_rng(0))
+        return norm / mu - 1, float(np.max(bounds.upper)) / mu - 1, \
+            float(np.max(bounds.lower)) / mu - 1, bounds
 
-    print("order | truncation: norm, µ | output-weighted truncation: norm, µ")
-    for order in ORDERS:
-        bt = judged(balanced_truncation(K, order=order)[0])
-        fw = judged(weighted_truncation(K, V, order))
-        print(f"{order:5d} | {bt[0]:+8.2%} {bt[1]:+8.2%} | {fw[0]:+8.2%} {fw[1]:+8.2%}",
-              flush=True)
+    def independent(K_red, bounds) -> str:
+        if check is None or ab_blocks is None:
+            return ""
+        peak = float(res.mu.omega[int(np.argmax(bounds.upper))]) if bounds else 1.0
+        ab = certified_mu(P, K_red, nmeas, ncon, nblock=ab_blocks[0], itype=ab_blocks[1],
+                          omega=np.append(check, peak))
+        pole = float(np.max(np.real(lft(G, K_red).poles())))
+        return f" | {ab / mu - 1:+8.2%} {pole:9.3g}"
+
+    def pct(x) -> str:
+        return "      --" if np.isnan(x) else f"{x:+8.2%}"
+
+    print("order | truncation: norm, µ, µ lower" + (" | weighted truncation: norm, µ"
+                                                    if V is not None else "")
+          + (" | AB13MD's µ, largest pole real part" if check is not None else ""))
+    print(f"{K.nstates:5d} | {pct(np.nan)} {0.0:+8.2%} {res.mu_lower_peak / mu - 1:+8.2%}"
+          + (" |" + " " * 18 if V is not None else "") + independent(K, res.mu), flush=True)
+    for order in range(1, K.nstates) if orders is None else orders:
+        try:
+            K_bt = balanced_truncation(K, order=order)[0]
+        except ValueError as exc:  # an order below the modes kept whole
+            print(f"{order:5d} | no truncation: {exc}", flush=True)
+            continue
+        bt = judged(K_bt)
+        line = f"{order:5d} | {pct(bt[0])} {pct(bt[1])} {pct(bt[2])}"
+        if V is not None:
+            fw = judged(weighted_truncation(K, V, order))
+            line += f" | {pct(fw[0])} {pct(fw[1])}"
+        print(line + independent(K_bt, bt[3]), flush=True)
+    return res
 
 
 def beside_dkpy(P, nmeas, ncon):
