@@ -8,14 +8,20 @@ the problem (``two_mass``: :func:`~lmi_suspension.examples.uncertain_two_mass`,
 :func:`~lmi_suspension.examples.stiffness_oscillator` on ``bench_dgk.py``'s 40-point
 grid without the D-scale search; ``seat``: the seat over m3 and k1 of
 ``bench_dgk.py``, ``seat_augmented_plant(SeatDesignOptions(include_paper=False))`` on
-``DEFAULT_OMEGA`` with ``replace(DEFAULT_MUSYN, max_iter=6, patience=2)``: ``seat`` and
-``seat complexify=True``), the others ``MusynOptions`` keywords (for ``seat``, these
-two included).  ``--orders`` (``oscillator``, ``seat``): the run at full order
+``DEFAULT_OMEGA`` with :data:`~lmi_suspension.seat.design.MIXED_MUSYN`, i.e.
+``replace(DEFAULT_MUSYN, max_iter=6, patience=2, reduce_order="auto")``: ``seat`` and
+``seat complexify=True``; ``seat reduce_order=None`` for the full order), the others
+``MusynOptions`` keywords (for ``seat``, these three included).  For ``oscillator`` and
+``seat`` the returned loop (and a reduced one's full-order loop) is certified again by
+AB13MD's scalings on ``CHECK`` (:func:`musyn_vs_dkpy.certified_mu`, independent of
+``musyn``; its time not counted).  ``--orders`` (``oscillator``, ``seat``): the run at full order
 (``reduce_order=None``), then for each lower order the balanced truncation of its
 controller: mixed µ on the result's dense grid (upper, lower) and by AB13MD's scalings
 on 800 frequencies over 1e-2..3e4 rad/s (independent of ``musyn``), relative to the full
 order's, and the closed loop's largest pole real part
-(:func:`musyn_orders.tradeoff`).  Run it under
+(:func:`musyn_orders.tradeoff`).  ``--store=PATH``: the full-order controller written
+to ``PATH`` (``lmi_suspension.io.save_controller``, how it was made in its metadata;
+``tests/data/seat_m3_k1_mixed_K.json``).  Run it under
 ``ulimit -v 4000000`` and ``timeout``: D-G-K with 10 G poles on the two-mass plant
 (``complex_candidate=None, max_gfit_poles=10``) filled a 4 GB address space at its
 second K-step (2026-12-02).
@@ -48,11 +54,11 @@ def problem(name: str, kw: dict):
                 MusynOptions(max_iter=8, dscale_search=0, **kw))
     if name == "seat":
         from lmi_suspension.seat.augmented import SeatDesignOptions, seat_augmented_plant
-        from lmi_suspension.seat.design import DEFAULT_MUSYN, DEFAULT_OMEGA
+        from lmi_suspension.seat.design import DEFAULT_OMEGA, MIXED_MUSYN
 
         aug = seat_augmented_plant(SeatDesignOptions(include_paper=False))
         return (aug.P, aug.nmeas, aug.ncon, aug.blk, DEFAULT_OMEGA,
-                replace(DEFAULT_MUSYN, **{"max_iter": 6, "patience": 2, **kw}))
+                replace(MIXED_MUSYN, **kw))
     raise SystemExit(f"--orders takes oscillator or seat, not {name}")
 
 
@@ -63,7 +69,8 @@ if __name__ == "__main__":
                  "lmi_suspension.mu.gfit"):
         logging.getLogger(name).setLevel(logging.WARNING)
     orders = "--orders" in sys.argv
-    args = [a for a in sys.argv[1:] if a != "--orders"]
+    store = next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--store=")), None)
+    args = [a for a in sys.argv[1:] if a != "--orders" and not a.startswith("--store=")]
     problem_name = args[0] if args else "two_mass"
     kw = {k.strip(): ast.literal_eval(v) for k, v in
           (item.split("=", 1) for item in args[1:])}
@@ -92,6 +99,37 @@ if __name__ == "__main__":
           f"{np.max(np.real(np.linalg.eigvals(np.asarray(res.CL.A)))):.3g}")
     if res.reduced_from is not None:
         print(f"reduced from {res.reduced_from} states (full-order µ {res.mu_peak_full:.4f})")
+    if problem_name in ("oscillator", "seat"):
+        from musyn_vs_dkpy import certified_mu
+
+        from lmi_suspension.mu.bounds import _ab13md_blocks
+        from lmi_suspension.umodel.blocks import BlockStructure
+
+        nblock, itype = _ab13md_blocks(BlockStructure.from_blk(blk))
+        grid = np.append(CHECK, res.peak_omega)
+        for name, K in (("returned", res.K), ("full-order", res.K_full)):
+            if K is not None:
+                ab = certified_mu(control.ss(P), K, nmeas, ncon, nblock=nblock, itype=itype,
+                                  omega=grid)
+                print(f"{name} controller ({K.nstates} states): AB13MD's µ {ab:.4f} on "
+                      f"CHECK and the peak frequency")
+    if store is not None:
+        import datetime
+        import subprocess
+
+        from lmi_suspension.io import save_controller
+
+        K_full = res.K if res.K_full is None else res.K_full
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                                text=True).stdout.strip()
+        save_controller(store, K_full, metadata={
+            "made": f"python benchmarks/musyn_mixed.py {' '.join(sys.argv[1:])} (commit "
+                    f"{commit}, {datetime.date.today()}, OpenBLAS "
+                    f"{os.environ.get('OPENBLAS_CORETYPE', 'native kernel')}): the "
+                    "full-order controller",
+            "mu_peak_full": res.mu_peak if res.K_full is None else res.mu_peak_full,
+            "problem": problem_name, "options": repr(kw)})
+        print(f"full-order controller ({K_full.nstates} states) written to {store}")
     if res.complex_run is not None:
         print(f"complexified run: {res.complex_run.seconds:.1f} s (wall), complex µ per iterate "
               f"{[round(h.mu_peak, 4) for h in res.complex_run.history]}, its mixed µ "
