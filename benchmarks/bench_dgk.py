@@ -21,7 +21,8 @@ def _record(benchmark, res):
     benchmark.extra_info.update(
         mu_per_iteration=[h.mu_peak for h in res.history], mu_peak_dense=res.mu_peak,
         mu_lower_peak_dense=res.mu_lower_peak, mu_bound=res.mu_bound,
-        stop_reason=res.stop_reason, controller_order=res.K.nstates)
+        stop_reason=res.stop_reason, controller_order=res.K.nstates,
+        reduced_from=res.reduced_from, mu_peak_full=res.mu_peak_full)
     assert res.mu_lower_peak <= res.mu_peak <= res.mu_bound
 
 
@@ -45,16 +46,18 @@ def test_bench_dgk_seat_m3_k1(benchmark, complexify):
     479 s (K order 73): µ there is set by the delay and performance blocks.
     2026-12-02 (cpu family 25, ``python benchmarks/musyn_mixed.py seat``): complex 2.6711
     in 4 s CPU; default D-G-K returns that controller (its own best 2.7407) in 15-18 s;
-    ``complex_candidate="start"`` 2.6646 (31 states) in 11-12 s."""
+    ``complex_candidate="start"`` 2.6646 (31 states) in 11-12 s.  Since 2026-12-03 the
+    mixed route's options, :data:`~lmi_suspension.seat.design.MIXED_MUSYN` (the same with
+    ``reduce_order="auto"``): the controller reduced to the least order within 1 % of the
+    full order's µ (``controller_order`` the reduced one's)."""
     from dataclasses import replace
 
     from lmi_suspension.seat.augmented import SeatDesignOptions, seat_augmented_plant
-    from lmi_suspension.seat.design import DEFAULT_MUSYN, DEFAULT_OMEGA
+    from lmi_suspension.seat.design import DEFAULT_OMEGA, MIXED_MUSYN
 
     aug = seat_augmented_plant(SeatDesignOptions(include_paper=False))
     res = benchmark.pedantic(
         musyn, args=(aug.P, aug.nmeas, aug.ncon, aug.blk),
-        kwargs=dict(omega=DEFAULT_OMEGA, options=replace(
-            DEFAULT_MUSYN, max_iter=6, patience=2, complexify=complexify)),
+        kwargs=dict(omega=DEFAULT_OMEGA, options=replace(MIXED_MUSYN, complexify=complexify)),
         rounds=1, iterations=1)
     _record(benchmark, res)

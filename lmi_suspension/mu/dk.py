@@ -179,8 +179,12 @@ class MusynOptions:
         states cost more than 1 %: balanced truncation +2.76 % (µ on the dense grid),
         frequency-weighted truncations +2.3 % and more, a truncation polished on the
         scaled plant with its D scalings held +1.60 % (83 s of CPU); the trade-off is in
-        ``docs/guide/dk.md``.  ``None``: the full-order controller.  The full-order
-        controller is kept in :attr:`MusynResult.K_full` (and its µ in
+        ``docs/guide/dk.md``.  With real blocks (mixed µ) on the seat over m3 and k1
+        (:data:`~lmi_suspension.seat.design.MIXED_MUSYN`, 2026-12-03): D-G-K's 31-state
+        controller to 8 states at +0.12 % (OpenBLAS Haswell), the complexified run's
+        13-state one to 7 at +0.70 % (SkylakeX), about 3 s of CPU for the search and the
+        reduced loop's mixed certificate.  ``None``: the full-order controller.  The
+        full-order controller is kept in :attr:`MusynResult.K_full` (and its µ in
         ``mu_peak_full``) whenever a reduction is kept.
     reduce_mu_tol : float
         Relative µ increase tolerated by the order reduction (default 1 %).
@@ -310,7 +314,11 @@ class MusynOptions:
         stalled on), or after those iterates where none improved; its records are then
         in ``complex_run.start_history`` (not reported to ``callback``; a kept start's
         are reported once it is decided), and D-G-K starts as with ``"keep"``.  The seat:
-        start kept, 2.6063 (31 states) in about 2.2 times the complexified run's CPU; the
+        start kept, 2.6063 (31 states) in about 2.2 times the complexified run's CPU
+        (re-measured 2026-12-03 on 4ec07eb, full order: kept under OpenBLAS Haswell and
+        Sandybridge, 2.5802 and 2.5814 with 31 states; abandoned under SkylakeX, which
+        returns the complexified controller, 2.6630 with 13 states: the K-steps' paths
+        split by kernel since 0f73eaf); the
         two-mass plant: abandoned at once (mixed 1.7779, complex 1.7787), 1.6089
         (2026-12-02, ``benchmarks/HISTORY.md``).  With ``K0``, the complexified
         run and the start of ``"keep"`` are from it.

@@ -81,11 +81,14 @@ DEFAULT_MUSYN = MusynOptions(method="best", max_iter=4, patience=1, max_dfit_ord
 #: and the controller reduced to the least order whose mixed µ stays within 1 % of the
 #: full order's (``reduce_order="auto"``; issue 64, item 4: at most twice the augmented
 #: plant's 13 states); ``musyn.K_full`` keeps the full-order controller.  On the seat over
-#: m3 and k1 (``benchmarks/musyn_mixed.py seat``, 2026-12-03): the complexified run's
-#: 13-state controller returned at mixed µ 2.6630, reduced to 7 states at 2.6817 (+0.70 %,
-#: AB13MD's scalings on 800 frequencies agree), 16.5 s of CPU against 15.3 s unreduced;
-#: 8 states cost +0.12 %, 9-12 nothing measurable, 5-6 about +2 %, 4 +9.7 %.  A tighter
-#: ``reduce_mu_tol`` trades states for µ (``benchmarks/HISTORY.md``).
+#: m3 and k1 (``benchmarks/musyn_mixed.py seat``, 2026-12-03, mixed µ on the dense grid,
+#: AB13MD's scalings on 800 frequencies agreeing): under OpenBLAS Haswell and Sandybridge
+#: D-G-K's 31-state controller is returned (2.5802, 2.5814), above the 26-state bound
+#: unreduced, and reduced to 8 states (+0.12 %, -1.06 %); under SkylakeX the complexified
+#: run's 13-state one (2.6630), reduced to 7 states (+0.70 %).  The reduction cost 3.1 s
+#: of CPU (median of three, 15.0 s against 11.9 s).  A tighter ``reduce_mu_tol`` trades
+#: states for µ (SkylakeX: 8 states +0.12 %, 9 no measurable change; ``--orders`` of that
+#: benchmark prints the table).
 MIXED_MUSYN = replace(DEFAULT_MUSYN, max_iter=6, patience=2, reduce_order="auto")
 
 #: Design grid, rad/s: 0.1 rad/s (below the Wk band) to ≈ 3000 rad/s (above 1/(25 ms)).
