@@ -14,12 +14,13 @@ grid without the D-scale search; ``seat``: the seat over m3 and k1 of
 ``MusynOptions`` keywords (for ``seat``, these three included).  For ``oscillator`` and
 ``seat`` the returned loop (and a reduced one's full-order loop) is certified again by
 AB13MD's scalings on ``CHECK`` (:func:`musyn_vs_dkpy.certified_mu`, independent of
-``musyn``; its time not counted).  ``--orders`` (``oscillator``, ``seat``): the run at full order
-(``reduce_order=None``), then for each lower order the balanced truncation of its
-controller: mixed µ on the result's dense grid (upper, lower) and by AB13MD's scalings
-on 800 frequencies over 1e-2..3e4 rad/s (independent of ``musyn``), relative to the full
-order's, and the closed loop's largest pole real part
-(:func:`musyn_orders.tradeoff`).  ``--store=PATH``: the full-order controller written
+``musyn``; its time not counted).  ``--orders`` (``oscillator``, ``seat``): the run at
+full order (``reduce_order=None``), then for each lower order the balanced truncation of
+its controller: mixed µ on the result's dense grid (upper, lower) and by AB13MD's
+scalings on 800 frequencies over 1e-2..3e4 rad/s (independent of ``musyn``), relative to
+the full order's, and the closed loop's largest pole real part
+(:func:`musyn_orders.tradeoff`; the seconds printed then include the table).
+``--store=PATH``: the full-order controller written
 to ``PATH`` (``lmi_suspension.io.save_controller``, how it was made in its metadata;
 ``tests/data/seat_m3_k1_mixed_K.json``).  Run it under
 ``ulimit -v 4000000`` and ``timeout``: D-G-K with 10 G poles on the two-mass plant
