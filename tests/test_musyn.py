@@ -1285,8 +1285,9 @@ def _check_seat_reduction(aug, res, K_full):
     apart from musyn: the returned controller has at most twice the augmented plant's
     states, its loop (python-control's ``lft``) is stable, and its mixed µ by AB13MD's
     scalings (60 frequencies, the peak searched between its neighbours) is within
-    ``reduce_mu_tol`` of the full-order loop's (measured 2026-12-03: 7 of 13 states,
-    +0.70 %, under OpenBLAS SkylakeX; 8 of 31, +0.12 %, under Haswell)."""
+    ``reduce_mu_tol`` of the full-order loop's (measured 2026-12-03 with 1 %: 7 of 13
+    states, +0.70 %, under OpenBLAS SkylakeX; 8 of 31, +0.12 %, under Haswell; with
+    0.2 %: 8 of 13, +0.12 %, under SkylakeX)."""
     from lmi_suspension.mu.bounds import _ab13md_blocks
     from lmi_suspension.umodel.blocks import BlockStructure
 
@@ -1308,8 +1309,9 @@ def _check_seat_reduction(aug, res, K_full):
     assert res.mu_lower_peak <= reduced * (1 + 1e-6)
 
 
-#: the mixed seat route's tolerance (``MIXED_MUSYN.reduce_mu_tol``, issue 64's 1 %)
-MIXED_TOL = 0.01
+#: the mixed seat route's tolerance (``MIXED_MUSYN.reduce_mu_tol``: 0.2 %, inside issue
+#: 64's 1 %, so that the seat's mixed µ stays below the complexified run's)
+MIXED_TOL = 0.002
 
 
 def test_the_seats_mixed_controller_is_reduced_within_one_percent_of_its_full_order():
@@ -1320,8 +1322,9 @@ def test_the_seats_mixed_controller_is_reduced_within_one_percent_of_its_full_or
     controller as ``K_full``; the guarantee is checked apart (:func:`_check_seat_reduction`).
     On 20 of ``DEFAULT_OMEGA``'s 50 frequencies and ``n_dense=20`` (90 dense points):
     3.2-3.7 s of CPU in musyn, where the route's grids (246 dense points) took 6.2 s for
-    the same order and µ (7 states, 2.6816 against 2.6817; 2026-12-03), and 0.4 s in the
-    check."""
+    the same order and µ (with a 1 % tolerance: 7 states, 2.6816 against 2.6817;
+    2026-12-03), and 0.4 s in the check.  With ``MIXED_TOL`` 0.2 %: 8 states, 2.66623
+    against the full order's 2.66304 (+0.12 %) under SkylakeX and Sandybridge."""
     from pathlib import Path
 
     from lmi_suspension.io import load_controller
