@@ -328,6 +328,15 @@ def _central_start(hinfsyn, P, nmeas: int, ncon: int, opts, syn):
         f"certified {central.gamma:.6g}",))
 
 
+#: where the K-step's γ minimisation starts (``HinfsynOptions.start``): the identity
+#: frame, not hinfsyn's default Riccati frame.  On dkpy's distillation example
+#: (``benchmarks/musyn_vs_dkpy.py``, default musyn, SkylakeX, 2026-12-03) the D-K path
+#: from the Riccati frame ended at µ 0.9712 with 13 states (full order 0.9625, 11.2 s of
+#: CPU), from the identity frame at 0.9600 with 15 (full order 0.9588, 12.5 s); on the
+#: project's distillation plant (``benchmarks/musyn_default.py``) both 0.9611
+_KSTEP_START = "identity"
+
+
 def _kstep_options(opts):
     """The options of every K-step: the user's, or the bisection Riccati search with
     Clarabel's γ minimisation and the controller LMI after it (:data:`_KSTEP_GAMMA_SOLVER`;
@@ -338,7 +347,7 @@ def _kstep_options(opts):
 
     return (opts.hinfsyn_options if opts.hinfsyn_options is not None
             else HinfsynOptions(riccati_search="bisection", controller="sdp",
-                                gamma_solver=_KSTEP_GAMMA_SOLVER))
+                                gamma_solver=_KSTEP_GAMMA_SOLVER, start=_KSTEP_START))
 
 
 def _level_led_lmi(hinfsyn, PD, nmeas: int, ncon: int, base, controller: str = "sdp"):
