@@ -32,8 +32,10 @@ and a climb) found the force or the stroke above its bound added as design seats
 bound (:func:`_force_corners`; ``--add-corners 0``: the searched seat alone, as ``a`` at
 1500 N's rounds 2 and 3 were made, one corner a round); at most
 :data:`ROUNDS` rounds, fewer when a round's search finds no violation.  The first round
-of ``a`` at 1500 N is the shipped ``mu_scheduled.json``'s bin 40-50 (the same subset,
-options, seed and start; ``--from-shipped`` reuses it, ``--fresh`` designs it again).
+of ``a`` at 1500 N is bin 40-50 of ``seat/data/mu_scheduled_unheld.json``, the first
+table, held at its design seats only, and shipped as ``mu_scheduled.json`` when
+``scheduled_tradeoff.json`` was made (the same subset, options, seed and start;
+``--from-shipped`` reuses it, ``--fresh`` designs it again).
 Every round's controller is kept under ``--work`` as soon as it is made and reused by a
 later run.
 
@@ -156,14 +158,14 @@ def design_point(key: str, u: float, work: Path, *, rounds: int = ROUNDS,
             K, rec = load_controller(part)
             log(f"  {key}:{u:g} round {index}: reused {part.name}")
         elif index == 1 and key == "a" and u == 1500.0 and from_shipped:
-            Ks, meta = load_controller(DATA / "mu_scheduled.json")
+            Ks, meta = load_controller(DATA / "mu_scheduled_unheld.json")
             K = Ks.at(m3=sum(BIN) / 2)
             t0 = time.process_time()
             u_seat, x1_seat = worst_bump_seats(K, subset, rng=np.random.default_rng(0),
                                                n=0, delays=RefineOptions().delays)
             b = next(b for b in meta["bins"] if tuple(b["estimates"]) == BIN)
             rec = {"index": 1, "cpu_seconds": b["seconds"], "search_cpu_seconds":
-                   time.process_time() - t0, "reused": "seat/data/mu_scheduled.json, "
+                   time.process_time() - t0, "reused": "seat/data/mu_scheduled_unheld.json, "
                    "bin 40-50 (the same subset, options, seed and start; its seconds are "
                    "its wall time on the loaded machine)",
                    "plants": [_seat_dict(p) for p in subset.corners(("m3", "k1"))],

@@ -705,3 +705,27 @@ def test_roads_and_monte_carlo_do_not_depend_on_the_design_draws(monkeypatch, tm
     assert a["monte_carlo"] == b["monte_carlo"]
     assert a["controllers"]["passive"] == b["controllers"]["passive"]
     assert a["iso_C"] == b["iso_C"]
+
+
+def test_controller_mat_of_node_controllers_of_different_orders(tmp_path):
+    """A schedule whose bins differ in order (the shipped one: 14, 14, 14 and 12 states)
+    cannot be one n × n × N array: each node's matrices go into a cell array, bit for bit,
+    with its order in ``Nx``; equal orders keep the array layout."""
+    from scipy.io import loadmat
+
+    K14 = control.ss(np.diag(-np.arange(1.0, 15.0)), np.ones((14, 2)), np.ones((1, 14)),
+                     [[0.5, -0.25]])
+    K12 = control.ss(np.diag(-np.arange(2.0, 14.0)), np.full((12, 2), 0.3),
+                     np.ones((1, 12)), [[0.125, 0.0]])
+    Ks = GriddedController.from_controllers({"m3": [30.0, 50.0, 70.0]}, [K14, K12],
+                                            interpolation="bins")
+    mat = loadmat(R._save_scheduled_mat(tmp_path / "k.mat", Ks, {"description": "t"}))
+    assert mat["Nx"].ravel().tolist() == [14.0, 12.0]
+    assert mat["A"].shape == (2, 1) and mat["A"][1, 0].shape == (12, 12)
+    for i, K in enumerate((K14, K12)):
+        for M in "ABCD":
+            assert np.array_equal(mat[M][i, 0], np.asarray(getattr(K, M)))
+    same = GriddedController.from_controllers({"m3": [30.0, 50.0, 70.0]}, [K14, K14],
+                                              interpolation="bins")
+    flat = loadmat(R._save_scheduled_mat(tmp_path / "s.mat", same, {}))
+    assert flat["A"].shape == (14, 14, 2) and flat["Nx"].ravel().tolist() == [14.0, 14.0]

@@ -1,7 +1,8 @@
 """The shipped tuned scheduled seat controller (``seat/data/mu_scheduled.json``, a table of
-occupant-route designs per bin of the estimated mass, made by
-``benchmarks/scheduled_tuned.py``) and the designs tuned for exactly one mass
-(``seat/data/mu_at_mass.json``).
+occupant-route designs per bin of the estimated mass, each held to 1500 N at the seats the
+worst-seat search finds, made by ``benchmarks/scheduled_tuned.py``) and the designs tuned
+for exactly one mass, held the same way (``seat/data/mu_at_mass.json``); the first
+tables, held at their design seats only, as ``*_unheld.json``.
 
 The independent checks: the seat's own closed loop (its poles without delay,
 :func:`~lmi_suspension.seat.loop.loop_poles`, and the exact-delay Nyquist count of
@@ -86,7 +87,7 @@ def test_references_stable_at_their_masses(at_mass):
 
 
 @pytest.mark.parametrize("name", ["mu_scheduled.json", "mu_at_mass.json",
-                                  "mu_scheduled_u1500.json"])
+                                  "mu_scheduled_unheld.json", "mu_at_mass_unheld.json"])
 def test_file_round_trip_bit_for_bit(tmp_path, name):
     K, meta = load_controller(DATA / name)
     again = save_scheduled_controller(tmp_path / name, K, metadata=meta)

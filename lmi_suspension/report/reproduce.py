@@ -297,16 +297,29 @@ def _save_scheduled_mat(path: Path, Ks, metadata: Mapping) -> Path:
     """A scheduled controller for MATLAB: its node controllers as an array of models
     (``A`` n × n × N, ``B``, ``C``, ``D``; ``P`` N × k the nodes, ``ParameterName``),
     the layout of :func:`~lmi_suspension.io.save_scheduled_mat`; doubles, so the numbers
-    are the file's."""
+    are the file's.  Where the node controllers differ in order (a bin's controller
+    designed smaller), ``A``, ``B``, ``C``, ``D`` are N × 1 cell arrays of each node's
+    matrices instead, and ``Nx`` gives the orders (in MATLAB: ``K = cellfun(@ss, s.A,
+    s.B, s.C, s.D, 'UniformOutput', false)``); padding them to one order would add modes
+    that are not the controller's."""
     import scipy.io
 
     from ..seat.schedule_use import schedule_nodes
 
     nodes = schedule_nodes(Ks)
     mats = [Ks.at(**p) for p in nodes]
-    data = {M: np.stack([np.asarray(getattr(K, M), dtype=float) for K in mats], axis=-1)
-            for M in "ABCD"}
-    data.update(P=np.array([[p[n] for n in Ks.names] for p in nodes], dtype=float),
+    orders = [int(K.nstates) for K in mats]
+    if len(set(orders)) == 1:
+        data = {M: np.stack([np.asarray(getattr(K, M), dtype=float) for K in mats], axis=-1)
+                for M in "ABCD"}
+    else:
+        data = {}
+        for M in "ABCD":
+            cells = np.empty((len(mats), 1), dtype=object)
+            for i, K in enumerate(mats):
+                cells[i, 0] = np.asarray(getattr(K, M), dtype=float)
+            data[M] = cells
+    data.update(Nx=np.asarray(orders, dtype=float),P=np.array([[p[n] for n in Ks.names] for p in nodes], dtype=float),
                 ParameterName=np.array(list(Ks.names), dtype=object).reshape(-1, 1),
                 InputName=np.array(["x1", "x3"], dtype=object).reshape(-1, 1),
                 OutputName=np.array(["u"], dtype=object).reshape(-1, 1),
