@@ -30,6 +30,28 @@ def test_tustin_keeps_stability_and_the_frequency_response():
     assert np.allclose(resp_d, resp_c, rtol=1e-9)
 
 
+def test_tustin_of_a_badly_scaled_realization_is_balanced_first():
+    """A lag controller in coordinates scaled by 1e-7 ... 1e7 (‖A‖ about 1e14, as
+    ``reproduce``'s nominal H∞ LMI controller had 8e11): scipy's Tustin map warned of an
+    ill-conditioned solve (LinAlgWarning) on the user's terminal.  Balanced first, it is
+    silent and its response is the well-scaled realization's map, computed here."""
+    import warnings
+
+    K = control.ss([[0.0, 1.0], [-12000.0, -260.0]], [[0.0], [1.0]], [[2.4e6, 100.0]],
+                   [[0.0]])                        # poles at 60 and 200 rad/s, companion form
+    T = np.diag([1e-7, 1e7])
+    Ti = np.diag([1e7, 1e-7])
+    bad = control.ss(Ti @ K.A @ T, Ti @ K.B, K.C @ T, K.D)
+    assert np.linalg.cond(np.eye(2) - 0.5e-3 * np.asarray(bad.A)) > 1e10  # the premise
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        Kd = discretise_controller(bad, 1e-3)
+    ref = control.sample_system(K, 1e-3, method="bilinear")
+    for w in (1.0, 60.0, 2000.0):
+        z = np.exp(1j * w * 1e-3)
+        assert np.allclose(np.asarray(Kd(z)), np.asarray(ref(z)), rtol=1e-9)
+
+
 def test_prewarped_tustin_is_exact_at_its_frequency():
     K = _lag_controller()
     w0 = 500.0
