@@ -319,7 +319,8 @@ def _save_scheduled_mat(path: Path, Ks, metadata: Mapping) -> Path:
             for i, K in enumerate(mats):
                 cells[i, 0] = np.asarray(getattr(K, M), dtype=float)
             data[M] = cells
-    data.update(Nx=np.asarray(orders, dtype=float),P=np.array([[p[n] for n in Ks.names] for p in nodes], dtype=float),
+    data.update(Nx=np.asarray(orders, dtype=float),
+                P=np.array([[p[n] for n in Ks.names] for p in nodes], dtype=float),
                 ParameterName=np.array(list(Ks.names), dtype=object).reshape(-1, 1),
                 InputName=np.array(["x1", "x3"], dtype=object).reshape(-1, 1),
                 OutputName=np.array(["u"], dtype=object).reshape(-1, 1),

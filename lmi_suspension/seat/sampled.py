@@ -28,9 +28,9 @@ import math
 
 import control
 import numpy as np
-import scipy.linalg
 
 from ..errors import DimensionError, ParameterError
+from ..lti.scaling import balanced_matrices
 from .model import SeatMatrices
 from .params import SeatParameters
 from .roads import RoadInput
@@ -140,25 +140,25 @@ def discretise_controller(K, dt: float = DEFAULT_SAMPLE_TIME, *, method: str = "
 
 #: condition number of ``I - A dt/2`` above which Tustin's map is taken of the balanced
 #: realization: the nominal H∞ LMI controller of ``reproduce`` (11 states, ‖A‖ 8.4e11)
-#: gave 9.1e15 and scipy's solve warned on the user's terminal; balanced, 232 (measured
+#: gave 9.1e15 and scipy's solve warned on the user's terminal; balanced, 231 (measured
 #: 2026-12-03); the shipped µ controllers stay below 1e3 and are mapped as they are
 _TUSTIN_COND = 1e10
 
 
 def _balanced_for_tustin(K: control.StateSpace, dt: float) -> control.StateSpace:
     """``K`` itself, or where ``I - A dt/2`` is ill-conditioned (:data:`_TUSTIN_COND`),
-    the same controller in the coordinates of ``scipy.linalg.matrix_balance`` (a
-    diagonal scaling by powers of two, so exact in floating point: the transfer function
-    is unchanged to the last bit of each product)."""
+    the same controller after the project's diagonal state balancing
+    (:func:`~lmi_suspension.lti.scaling.balanced_matrices`: powers of two, so every entry
+    is scaled exactly and the transfer function is the same)."""
     A = np.asarray(K.A, dtype=float)
     if A.size == 0 or np.linalg.cond(np.eye(A.shape[0]) - 0.5 * dt * A) <= _TUSTIN_COND:
         return K
-    _, (scale, _) = scipy.linalg.matrix_balance(A, permute=False, separate=True)
     logger.info("Tustin's map of a badly scaled realization (cond(I - A dt/2) above "
                 "%.0e): balanced first", _TUSTIN_COND)
-    return control.ss(A * (1.0 / scale)[:, None] * scale[None, :],
-                      np.asarray(K.B) / scale[:, None], np.asarray(K.C) * scale[None, :],
-                      K.D, inputs=K.input_labels, outputs=K.output_labels, name=K.name)
+    Ab, Bb, Cb = balanced_matrices(A, np.asarray(K.B, dtype=float),
+                                   np.asarray(K.C, dtype=float))
+    return control.ss(Ab, Bb, Cb, K.D, inputs=K.input_labels, outputs=K.output_labels,
+                      name=K.name)
 
 
 def simulate_sampled(Kd, road: RoadInput, *, delay: float = 0.0,

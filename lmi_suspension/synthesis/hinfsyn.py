@@ -35,8 +35,8 @@ _RELAX_GROWTH = 4.0
 #: bound on the refinements started by a controller that beats the LMI optimum
 _FORCED_PASSES = 3
 #: a certified γ this far below the LMI optimum proves the minimisation stopped high and
-#: starts a refinement.  With gamma_relax (5e-4) instead, COMPleib-like plant a of
-#: tests/test_tune.py kept an optimum 7.1e-5 above its certified controller under
+#: starts a refinement.  With gamma_relax (5e-4) instead, plant a of tests/test_tune.py
+#: (2 states) kept an optimum 7.1e-5 above its certified controller under
 #: OpenBLAS Sandybridge (the minimisation in the Riccati frame, CVXOPT "optimal";
 #: 2.5e-8 above SLICOT's optimum under SkylakeX), measured 2026-12-03
 _BEATEN_RTOL = 1e-6
