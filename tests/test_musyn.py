@@ -1339,6 +1339,47 @@ def test_the_seats_mixed_controller_is_reduced_within_one_percent_of_its_full_or
     _check_seat_reduction(aug, res, K_full)
 
 
+def test_a_seeded_mixed_certificate_is_the_unseeded_peak_and_a_valid_bound():
+    """The reduced loop's mixed-µ certificate seeded with the full loop's D-G scalings
+    (``dk._final_bounds(..., seed=...)``, as ``musyn``'s reduction takes it): at every
+    frequency the returned scalings certify the returned upper bound (the generalized
+    eigenvalue bound recomputed here from them), the bound is nowhere below AB13MD's own
+    by more than its accuracy, and the peak is AB13MD's unseeded peak; the lower bound
+    is taken at the peak.  The loops: the stored 13-state seat controller
+    (``tests/data/seat_m3_k1_mixed_K.json``) and its 8-state balanced truncation."""
+    from pathlib import Path
+
+    from lmi_suspension.io import load_controller
+    from lmi_suspension.lti.scaling import balanced_statespace
+    from lmi_suspension.mu.bounds import _certify
+    from lmi_suspension.mu.dk import _final_bounds, _try_reduce
+    from lmi_suspension.mu.steps import mu_part
+    from lmi_suspension.umodel.blocks import BlockStructure
+
+    K_full, _ = load_controller(Path(__file__).parent / "data" / "seat_m3_k1_mixed_K.json")
+    aug = _seat_m3_k1()
+    struct = BlockStructure.from_blk(aug.blk)
+    w = np.logspace(-1, 3.5, 60)
+    loops = [balanced_statespace(mu_part(lft(aug.P, K, aug.nmeas, aug.ncon), struct))
+             for K in (K_full, _try_reduce(K_full, 8))]
+    full = _final_bounds(loops[0], struct, w, np.random.default_rng(0))
+    plain = _final_bounds(loops[1], struct, w, np.random.default_rng(0))
+    seeded = _final_bounds(loops[1], struct, w, np.random.default_rng(0), seed=full)
+    M = freqresp(loops[1], w)
+    XL = np.einsum("jik,jlk->ilk", seeded.D_left.conj(), seeded.D_left)
+    XR = np.einsum("jik,jlk->ilk", seeded.D_right.conj(), seeded.D_right)
+    beta = np.array([_certify(M[:, :, k], XL[:, :, k], XR[:, :, k], seeded.G[:, :, k])
+                     for k in range(w.size)])
+    assert np.all(beta <= seeded.upper * (1 + 1e-9))
+    assert np.all(seeded.upper >= plain.upper * (1 - 1e-6))
+    assert seeded.peak == pytest.approx(plain.peak, rel=1e-9)
+    # the seed spared AB13MD away from the peak: its bound stands there, above AB13MD's
+    assert np.any(seeded.upper > plain.upper * (1 + 1e-6))
+    k = int(np.argmax(seeded.upper))
+    assert 0 < seeded.lower[k] <= seeded.upper[k]
+    assert np.max(seeded.lower) == pytest.approx(np.max(plain.lower), rel=1e-6)
+
+
 @pytest.mark.slow  # the whole D-G-K run: about 15 s of CPU (2026-12-03)
 def test_the_seats_mixed_route_returns_a_reduced_controller():
     """``benchmarks/musyn_mixed.py seat`` as a test: the mixed route's whole run

@@ -818,6 +818,16 @@ def _real_candidate(M, struct, Q, opts):
     def Qt(theta):
         return np.where(cmask, Q * np.exp(1j * theta), Q)
 
+    # M Q(θ) = M Q_real + e^{jθ} M Q_complex: the root finding's determinant evaluates
+    # the two products once (the root finding was 65 % of the mixed lower bound's time
+    # on the seat over m3 and k1, most of it rebuilding Q(θ) and M Q(θ) per evaluation)
+    MQr, MQc = M @ np.where(cmask, 0, Q), M @ np.where(cmask, Q, 0)
+    eye = np.eye(M.shape[0])
+
+    def F(v):
+        d = np.linalg.det(eye - v[1] * (MQr + np.exp(1j * v[0]) * MQc))
+        return [d.real, d.imag]
+
     thetas = [0.0] if not cmask.any() else np.linspace(0, 2 * np.pi, 12, endpoint=False)
     for th0 in thetas:
         lam = np.linalg.eigvals(M @ Qt(th0))
@@ -825,9 +835,6 @@ def _real_candidate(M, struct, Q, opts):
             if abs(lk) == 0:
                 continue
             if cmask.any():
-                def F(v):
-                    d = np.linalg.det(np.eye(M.shape[0]) - v[1] * M @ Qt(v[0]))
-                    return [d.real, d.imag]
                 sol = scipy.optimize.root(F, [th0, 1.0 / abs(lk)], method="hybr")
                 th, alpha = sol.x
             else:

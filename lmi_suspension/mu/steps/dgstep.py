@@ -18,7 +18,8 @@ import numpy as np
 from ...lti.norms import freqresp
 from . import DKSetup, LoopAnalysis
 
-__all__ = ["MussvStep", "mixed_bounds", "lower_where_it_counts"]
+__all__ = ["MussvStep", "mixed_bounds", "lower_where_it_counts",
+           "with_lower_where_it_counts"]
 
 
 #: the mixed-µ lower bound of :func:`mixed_bounds` is computed at this many frequencies
@@ -55,6 +56,18 @@ def mixed_bounds(M, struct, omega, rng, options=None):
     upper = np.asarray(mu.upper, dtype=float)
     if upper.ndim == 0 or upper.size == 0:
         return mussv(M, struct, omega=omega, rng=rng, options=opts)
+    return with_lower_where_it_counts(mu, M, struct, omega, rng, opts)
+
+
+def with_lower_where_it_counts(mu, M, struct, omega, rng, options=None):
+    """``mu`` (upper bounds of ``M`` over ``omega`` and their scalings) with ``mussv``'s
+    lower bound at the frequencies of the highest upper bounds (``_LOWER_POINTS``) and
+    the highest local maxima (``_LOWER_PEAKS``), zero elsewhere; its ``lower`` and
+    ``delta`` are replaced, its timings and warnings extended."""
+    from ..bounds import MussvOptions, MussvTimings, mussv
+
+    opts = MussvOptions() if options is None else options
+    upper = np.asarray(mu.upper, dtype=float)
     idx = list(np.argsort(-upper, kind="stable")[:_LOWER_POINTS])
     if upper.size >= 3:
         inner = np.flatnonzero((upper[1:-1] >= upper[:-2]) & (upper[1:-1] >= upper[2:])) + 1
@@ -64,7 +77,7 @@ def mixed_bounds(M, struct, omega, rng, options=None):
                 options=opts)
     lower = np.zeros_like(upper)
     lower[idx] = np.minimum(np.asarray(sub.lower), upper[idx])
-    delta = np.array(mu.delta)
+    delta = np.zeros(np.asarray(mu.delta).shape, dtype=complex)
     delta[..., idx] = np.asarray(sub.delta)
     timings = MussvTimings(upper=mu.timings.upper, lower=sub.timings.total,
                            total=mu.timings.total + sub.timings.total)
