@@ -20,7 +20,9 @@ its controller: mixed µ on the result's dense grid (upper, lower) and by AB13MD
 scalings on 800 frequencies over 1e-2..3e4 rad/s (independent of ``musyn``), relative to
 the full order's, and the closed loop's largest pole real part
 (:func:`musyn_orders.tradeoff`; the seconds printed then include the table).
-``--store=PATH``: the full-order controller written
+``--ratio=N``: the mixed route and the complexified run, ``N`` rounds alternating
+which goes first, CPU of each ``musyn`` call and the ratio of the medians (issue 64's
+time targets; :func:`ratio`).  ``--store=PATH``: the full-order controller written
 to ``PATH`` (``lmi_suspension.io.save_controller``, how it was made in its metadata;
 ``tests/data/seat_m3_k1_mixed_K.json``).  Run it under
 ``ulimit -v 4000000`` and ``timeout``: D-G-K with 10 G poles on the two-mass plant
@@ -63,6 +65,44 @@ def problem(name: str, kw: dict):
     raise SystemExit(f"--orders takes oscillator or seat, not {name}")
 
 
+def _cpu() -> float:
+    """CPU seconds of this process and its finished children (AB13MD's)."""
+    t = os.times()
+    return t.user + t.system + t.children_user + t.children_system
+
+
+def ratio(name: str, kw: dict, rounds: int) -> None:
+    """``--ratio=N``: the mixed route (the problem's options) and the complexified run
+    (``complexify=True`` besides) in ``N`` rounds, their order alternating; CPU seconds
+    of each ``musyn`` call, µ, and the ratio mixed / complexified per round and of the
+    medians (issue 64 asks at most 1.5)."""
+    def run(complexify: bool):
+        extra = dict(kw, complexify=True) if complexify else kw
+        if name == "two_mass":
+            P, nmeas, ncon, blk, omega = uncertain_two_mass(), 1, 1, None, None
+            options = MusynOptions(**extra)
+        else:
+            P, nmeas, ncon, blk, omega, options = problem(name, extra)
+        c0 = _cpu()
+        res = musyn(P, nmeas, ncon, blk, omega=omega, options=options)
+        return _cpu() - c0, res
+
+    rows = []
+    for r in range(rounds):
+        order = (True, False) if r % 2 == 0 else (False, True)
+        got = {c: run(c) for c in order}
+        rows.append((got[False][0], got[True][0]))
+        for c in order:
+            cpu, res = got[c]
+            print(f"round {r + 1} {'complexified' if c else 'mixed       '}: CPU {cpu:5.1f} s, "
+                  f"µ {res.mu_peak:.4f} (lower {res.mu_lower_peak:.4f}), {res.K.nstates} "
+                  f"states", flush=True)
+    mixed, cx = (np.array(v) for v in zip(*rows))
+    print(f"{name} {kw}: median CPU mixed {np.median(mixed):.1f} s, complexified "
+          f"{np.median(cx):.1f} s, ratio of medians {np.median(mixed) / np.median(cx):.2f} "
+          f"(per round {', '.join(f'{m / c:.2f}' for m, c in zip(mixed, cx))})")
+
+
 if __name__ == "__main__":
     logging.basicConfig(level=logging.INFO, format="%(relativeCreated)7.0f %(message)s")
     for name in ("lmi_suspension.synthesis", "lmi_suspension.lti", "lmi_suspension.mu.dfit",
@@ -71,10 +111,17 @@ if __name__ == "__main__":
         logging.getLogger(name).setLevel(logging.WARNING)
     orders = "--orders" in sys.argv
     store = next((a.split("=", 1)[1] for a in sys.argv if a.startswith("--store=")), None)
-    args = [a for a in sys.argv[1:] if a != "--orders" and not a.startswith("--store=")]
+    rounds = next((int(a.split("=", 1)[1]) for a in sys.argv if a.startswith("--ratio=")),
+                  None)
+    args = [a for a in sys.argv[1:] if a != "--orders" and not a.startswith(("--store=",
+                                                                            "--ratio="))]
     problem_name = args[0] if args else "two_mass"
     kw = {k.strip(): ast.literal_eval(v) for k, v in
           (item.split("=", 1) for item in args[1:])}
+    if rounds is not None:
+        logging.getLogger("lmi_suspension").setLevel(logging.WARNING)
+        ratio(problem_name, kw, rounds)
+        sys.exit(0)
     t0, c0 = time.perf_counter(), os.times()
     if orders:
         from musyn_orders import tradeoff
