@@ -677,14 +677,20 @@ def _final_bounds(CL, struct: BlockStructure, omega: np.ndarray, rng, seed=None,
     order's dense certificate went from 2.1 to 0.8 s under cProfile, µ 2.6007 and its
     lower bound 2.5968 as before (2026-12-03).
 
-    ``lower=False`` (real blocks only): AB13MD's upper bound alone, the lower bound
-    left at zero (:func:`_dense_certificate` takes it once the peaks are refined).
+    ``lower=False`` (real blocks only; ignored otherwise): AB13MD's upper bound alone,
+    the lower bound left at zero (:func:`_dense_certificate` takes it once the peaks
+    are refined).  With a seed and real blocks, ``upper`` away from the peak is the
+    seed's certified bound, not AB13MD's (``method`` names the refinement's); the
+    scalings returned beside it are the ones that certify it at each frequency.
     """
     from .bounds import MussvOptions, MussvTimings, _ab13md_blocks, _certify, mussv
     from .steps.dgstep import (lower_where_it_counts, mixed_bounds,
                                with_lower_where_it_counts)
 
     t0 = time.perf_counter()
+    if seed is not None and (seed.omega is None or not np.array_equal(
+            np.asarray(seed.omega, dtype=float), np.asarray(omega, dtype=float))):
+        raise ValueError("the seed's bounds must be on the same frequency grid")
     M = freqresp(CL, omega)
     mixed = lower_where_it_counts(struct)  # real blocks: AB13MD's upper bound
     if mixed and seed is None:
@@ -723,7 +729,7 @@ def _final_bounds(CL, struct: BlockStructure, omega: np.ndarray, rng, seed=None,
             break
         exact = mussv(M[:, :, batch], struct, method=refine, omega=omega[batch],
                       options=MussvOptions(compute_lower=False))
-        kept = np.asarray(exact.upper) < upper[batch]  # the fast bound is kept elsewhere
+        kept = np.asarray(exact.upper) < upper[batch]  # the fast or seed's bound elsewhere
         better = batch[kept]
         upper[better] = np.asarray(exact.upper)[kept]
         for k, v in fields.items():
@@ -734,10 +740,11 @@ def _final_bounds(CL, struct: BlockStructure, omega: np.ndarray, rng, seed=None,
         spent = time.perf_counter() - t0
         bounds = replace(mu, upper=upper, omega=omega, peak=float(upper[k_peak]),
                          peak_omega=float(omega[k_peak]), method=refine, warnings=(),
+                         blk=struct, lower=np.zeros_like(upper),
+                         delta=np.zeros((*struct.shape_delta, omega.size), dtype=complex),
                          timings=MussvTimings(upper=spent, lower=0.0, total=spent), **fields)
         if not lower:
-            return replace(bounds, lower=np.zeros_like(upper),
-                           delta=np.zeros(np.asarray(seed.delta).shape, dtype=complex))
+            return bounds
         return with_lower_where_it_counts(bounds, M, struct, omega, rng)
     # (equal bounds can cross by roundoff once the upper one is exact)
     return replace(mu, upper=upper, lower=np.minimum(mu.lower, upper), peak=float(upper[k_peak]),
@@ -1608,9 +1615,9 @@ def _scaled_norm(PD, K_red, setup) -> float:
 def _within(CL_red, struct, final, dense, limit: float, rng) -> bool:
     """Whether µ of ``CL_red`` stays at or below ``limit`` on ``dense``.  The full loop's
     scalings (``final``) are feasible for any loop, so ``_certify`` with them bounds the
-    truncated loop's µ at each frequency; where that bound exceeds ``limit``, µ is
-    computed (by :func:`_final_bounds`), in falling order of the bound, until one is
-    above the limit.  The verdict is the dense grid's: on default ``musyn``'s
+    truncated loop's µ at each frequency; where that bound exceeds ``limit``, µ's upper
+    bound is computed (by :func:`_final_bounds`; with real blocks AB13MD's alone, no
+    lower bound), in falling order of the bound, until one is above the limit.  The verdict is the dense grid's: on default ``musyn``'s
     distillation loop the order search found the same order (15) and µ (0.960037) as
     computing µ on the whole dense grid for every order tried, in 1.4 s of CPU instead
     of 5.8 s, the chosen order's dense µ included (measured 2026-12-02)."""

@@ -63,7 +63,8 @@ def with_lower_where_it_counts(mu, M, struct, omega, rng, options=None):
     """``mu`` (upper bounds of ``M`` over ``omega`` and their scalings) with ``mussv``'s
     lower bound at the frequencies of the highest upper bounds (``_LOWER_POINTS``) and
     the highest local maxima (``_LOWER_PEAKS``), zero elsewhere; its ``lower`` and
-    ``delta`` are replaced, its timings and warnings extended."""
+    ``delta`` are replaced, its timings and warnings extended.  ``options``: ``mussv``'s
+    for the lower bound (default :class:`~lmi_suspension.mu.bounds.MussvOptions`)."""
     from ..bounds import MussvOptions, MussvTimings, mussv
 
     opts = MussvOptions() if options is None else options
@@ -77,7 +78,7 @@ def with_lower_where_it_counts(mu, M, struct, omega, rng, options=None):
                 options=opts)
     lower = np.zeros_like(upper)
     lower[idx] = np.minimum(np.asarray(sub.lower), upper[idx])
-    delta = np.zeros(np.asarray(mu.delta).shape, dtype=complex)
+    delta = np.zeros((*struct.shape_delta, upper.size), dtype=complex)
     delta[..., idx] = np.asarray(sub.delta)
     timings = MussvTimings(upper=mu.timings.upper, lower=sub.timings.total,
                            total=mu.timings.total + sub.timings.total)
