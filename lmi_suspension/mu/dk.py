@@ -1617,15 +1617,14 @@ def _within(CL_red, struct, final, dense, limit: float, rng) -> bool:
     scalings (``final``) are feasible for any loop, so ``_certify`` with them bounds the
     truncated loop's µ at each frequency; where that bound exceeds ``limit``, µ's upper
     bound is computed (by :func:`_final_bounds`; with real blocks AB13MD's alone, no
-    lower bound), in falling order of the bound, until one is above the limit.  The verdict is the dense grid's: on default ``musyn``'s
-    distillation loop the order search found the same order (15) and µ (0.960037) as
-    computing µ on the whole dense grid for every order tried, in 1.4 s of CPU instead
-    of 5.8 s, the chosen order's dense µ included (measured 2026-12-02)."""
-    from .bounds import MussvOptions, _certify, mussv
-    from .steps.dgstep import lower_where_it_counts
+    lower bound), in falling order of the bound, until one is above the limit.  The
+    verdict is the dense grid's: on default ``musyn``'s distillation loop the order
+    search found the same order (15) and µ (0.960037) as computing µ on the whole dense
+    grid for every order tried, in 1.4 s of CPU instead of 5.8 s, the chosen order's
+    dense µ included (measured 2026-12-02)."""
+    from .bounds import _certify
 
     M = freqresp(CL_red, dense)
-    mixed = lower_where_it_counts(struct)
     XL = np.einsum("jik,jlk->ilk", final.D_left.conj(), final.D_left)
     XR = np.einsum("jik,jlk->ilk", final.D_right.conj(), final.D_right)
     beta = np.array([_certify(M[:, :, k], XL[:, :, k], XR[:, :, k], final.G[:, :, k])
@@ -1634,11 +1633,8 @@ def _within(CL_red, struct, final, dense, limit: float, rng) -> bool:
     over = over[np.argsort(-beta[over], kind="stable")]  # highest first
     for start in range(0, over.size, _REFINE_BATCH):
         batch = over[start:start + _REFINE_BATCH]
-        if mixed:  # the verdict needs AB13MD's upper bound alone, not the lower
-            mu = mussv(M[:, :, batch], struct, omega=dense[batch],
-                       options=MussvOptions(compute_lower=False))
-        else:
-            mu = _final_bounds(CL_red, struct, dense[batch], rng)
+        # the verdict needs the upper bound alone (with real blocks no lower bound)
+        mu = _final_bounds(CL_red, struct, dense[batch], rng, lower=False)
         if float(np.max(mu.upper)) > limit:
             return False
     return True
