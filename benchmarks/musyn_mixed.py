@@ -22,7 +22,9 @@ the full order's, and the closed loop's largest pole real part
 (:func:`musyn_orders.tradeoff`; the seconds printed then include the table).
 ``--ratio=N``: the mixed route and the complexified run, ``N`` rounds alternating
 which goes first, CPU of each ``musyn`` call and the ratio of the medians (issue 64's
-time targets; :func:`ratio`).  ``--store=PATH``: the full-order controller written
+time targets; :func:`ratio`), each call's time split by phase (:func:`phases`), and the
+floor under the ratio that the mixed route's complexified run and K-steps set.
+``--store=PATH``: the full-order controller written
 to ``PATH`` (``lmi_suspension.io.save_controller``, how it was made in its metadata;
 ``tests/data/seat_m3_k1_mixed_K.json``).  Run it under
 ``ulimit -v 4000000`` and ``timeout``: D-G-K with 10 G poles on the two-mass plant
@@ -71,6 +73,20 @@ def _cpu() -> float:
     return t.user + t.system + t.children_user + t.children_system
 
 
+def phases(res) -> str:
+    """Where a ``musyn`` call's wall time went, from its own records: the complexified
+    run inside a mixed route, the K-steps, D/G steps and fits of its iterations, and the
+    rest (an abandoned start from the complexified controller, the order search, the
+    dense certificate, the interval bound)."""
+    k = sum(h.seconds_k for h in res.history)
+    d = sum(h.seconds_d for h in res.history)
+    f = sum(h.seconds_fit for h in res.history)
+    cx = res.complex_run.seconds if res.complex_run is not None else 0.0
+    head = f"complexified run {cx:.1f} s, " if res.complex_run is not None else ""
+    return (f"{head}K-steps {k:.1f} s, D/G steps {d:.1f} s, fits {f:.1f} s, rest "
+            f"{res.seconds - cx - k - d - f:.1f} s (wall)")
+
+
 def ratio(name: str, kw: dict, rounds: int) -> None:
     """``--ratio=N``: the mixed route (the problem's options) and the complexified run
     (``complexify=True`` besides) in ``N`` rounds, their order alternating; CPU seconds
@@ -96,7 +112,13 @@ def ratio(name: str, kw: dict, rounds: int) -> None:
             cpu, res = got[c]
             print(f"round {r + 1} {'complexified' if c else 'mixed       '}: CPU {cpu:5.1f} s, "
                   f"µ {res.mu_peak:.4f} (lower {res.mu_lower_peak:.4f}), {res.K.nstates} "
-                  f"states", flush=True)
+                  f"states; {phases(res)}", flush=True)
+        mixed_res, cx_res = got[False][1], got[True][1]
+        if mixed_res.complex_run is not None:
+            k_steps = sum(h.seconds_k for h in mixed_res.history)
+            print(f"round {r + 1} floor: (the mixed route's complexified run + its D-G-K "
+                  f"K-steps) / the complexified call = "
+                  f"{(mixed_res.complex_run.seconds + k_steps) / cx_res.seconds:.2f} (wall)")
     mixed, cx = (np.array(v) for v in zip(*rows))
     print(f"{name} {kw}: median CPU mixed {np.median(mixed):.1f} s, complexified "
           f"{np.median(cx):.1f} s, ratio of medians {np.median(mixed) / np.median(cx):.2f} "
