@@ -287,12 +287,13 @@ class MusynOptions:
         complexified run's controller certifies.  ``"keep"``: D-G-K starts as without
         it (from the central controller, or ``K0``); ``"start"``: D-G-K starts from the
         complexified run's controller (its first iterate, as ``K0``).  Neither start wins
-        everywhere (2026-12-02, ``docs/guide/dk.md``): on the two-mass plant
+        everywhere (2026-12-03, ``docs/guide/dk.md``): on the two-mass plant
         (:func:`~lmi_suspension.examples.uncertain_two_mass`) D-G-K from the central
-        controller reached 1.6117 where from the complexified one its second K-step
-        failed (1.7778, the complexified controller, in 93 s against 162 s); on the
-        oscillator of ``tests/test_dgk.py`` 1.0659 against 1.0391, both in about 60 s
-        (complexified D-K: 1.7778 in 68 s and 1.1140 in 44 s).  ``stop_reason`` says which
+        controller reaches 1.6236 where from the complexified one no iterate beats that
+        controller (1.7820 returned); on the seat over m3 and k1 the start from the
+        complexified controller reaches 2.6063 against 2.7546 from the beginning; on the
+        oscillator of ``tests/test_dgk.py`` both reach 0.9926 (complexified D-K: 1.7820,
+        2.6760 and 1.1165).  ``stop_reason`` says which
         controller is returned (``best_iteration`` 0: the complexified run's; 1 where
         D-G-K started from it) and
         :attr:`MusynResult.complex_run` holds that run (its records do not go to
